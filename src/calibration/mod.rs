@@ -1,0 +1,1 @@
+//! The paper's calibration procedures (Sec. IV), on simulated or recorded bench data.

@@ -1,0 +1,1 @@
+//! The cell: where contact forces and wavelengths come from (simulation now, real drivers later).

@@ -1,0 +1,1 @@
+//! Control code shared by the simulated and the real cell.

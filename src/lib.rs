@@ -1,0 +1,25 @@
+//! # tendril: a digital twin of an FBG-sensed grow-and-twine gripping cell
+//!
+//! Data flows one way around the loop, and the modules follow it:
+//!
+//! ```text
+//!  cell (sim or real)                          |  control (shared)
+//!  cell::physics  -> contact force             |
+//!  cell::fbg      -> wavelengths (interrogator)|-> control::estimate (eq. 8) -> force
+//!                                              |   control::pid, control::task -> commands
+//!  cell::physics  <- actuator commands  <------|
+//!                  hardware: the trait at the seam
+//! ```
+//!
+//! - [`scenario`]: TOML scenarios, `--set` overrides and validation errors naming the key.
+//! - [`cell`]: where forces and wavelengths come from (MuJoCo scene + FBG forward model).
+//! - [`control`]: what runs the same on the twin and on the real cell.
+//! - [`calibration`]: the paper's calibration procedures, for simulated or recorded bench data.
+//! - [`reproduce`]: the paper's figures next to the twin's.
+
+pub mod calibration;
+pub mod cell;
+pub mod cli;
+pub mod control;
+pub mod reproduce;
+pub mod scenario;

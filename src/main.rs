@@ -1,0 +1,4 @@
+//! The `tendril` command line.
+fn main() -> std::process::ExitCode {
+    tendril::cli::main()
+}

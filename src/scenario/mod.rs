@@ -1,0 +1,88 @@
+//! Scenario files: TOML in, typed and validated configuration out.
+//!
+//! Every scenario type is read the same way ([`load`]): the file is parsed to a TOML table,
+//! `--set key=value` overrides are applied at their dotted paths ([`overrides`]), the table is
+//! deserialised with unknown keys rejected, and the result is checked with [`Validate`]. Any
+//! failure is a [`ScenarioError`] that names the file, the dotted key and the reason.
+
+mod overrides;
+mod validate;
+
+pub use overrides::{Override, apply_overrides};
+pub use validate::{Checker, Validate};
+
+use serde::de::DeserializeOwned;
+use std::path::{Path, PathBuf};
+
+/// Why a scenario could not be loaded. Every variant names the file it came from.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        /// The scenario file.
+        file: PathBuf,
+        /// The underlying IO error.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML.
+    #[error("{file}: not valid TOML: {message}")]
+    Syntax {
+        /// The scenario file.
+        file: PathBuf,
+        /// The parser's message, with line and column.
+        message: String,
+    },
+    /// A key is unknown, missing, of the wrong type or out of range.
+    #[error("{file}: key `{key}`: {reason}")]
+    Invalid {
+        /// The scenario file.
+        file: PathBuf,
+        /// Dotted path of the key at fault (`physics.timestep`), or `(top level)`.
+        key: String,
+        /// What is wrong and what is expected.
+        reason: String,
+    },
+    /// A `--set` argument is malformed or targets something that is not a table.
+    #[error("--set {arg}: {reason}")]
+    BadOverride {
+        /// The argument as given.
+        arg: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+}
+
+/// Reads, overrides, deserialises and validates a scenario of type `T` from `file`.
+pub fn load<T: DeserializeOwned + Validate>(file: &Path, overrides: &[Override]) -> Result<T, ScenarioError> {
+    let text = std::fs::read_to_string(file).map_err(|source| ScenarioError::Io { file: file.into(), source })?;
+    from_str(&text, file, overrides)
+}
+
+/// As [`load`], from text already in memory; `file` is only used in messages.
+pub fn from_str<T: DeserializeOwned + Validate>(
+    text: &str,
+    file: &Path,
+    overrides: &[Override],
+) -> Result<T, ScenarioError> {
+    let mut table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.into(), message: e.to_string() })?;
+    apply_overrides(&mut table, overrides)?;
+    from_table(table, file)
+}
+
+/// Deserialises and validates an already-parsed table (sweeps build these directly).
+pub fn from_table<T: DeserializeOwned + Validate>(table: toml::Table, file: &Path) -> Result<T, ScenarioError> {
+    let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        let key = if path == "." { "(top level)".to_string() } else { path };
+        ScenarioError::Invalid { file: file.into(), key, reason: e.into_inner().to_string() }
+    })?;
+    let mut checker = Checker::default();
+    value.validate(&mut checker);
+    match checker.into_first_error() {
+        None => Ok(value),
+        Some((key, reason)) => Err(ScenarioError::Invalid { file: file.into(), key, reason }),
+    }
+}

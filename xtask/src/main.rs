@@ -1,0 +1,125 @@
+//! `cargo xtask <task>`: the project's set-up, with nothing to install by hand.
+//!
+//! MuJoCo must exist before `mujoco-rs` builds, so these tasks live in a separate package that
+//! does not depend on it: `cargo xtask` fetches the library from PyPI first, then runs cargo.
+//!
+//! - `cargo xtask fetch`: unpack MuJoCo 3.17.0 from the PyPI wheel into `vendor/mujoco/lib`.
+//! - `cargo xtask main`: fetch, then run the main job (`tendril reproduce ...`).
+//! - `cargo xtask test`: fetch, then run the whole test suite.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+const MUJOCO_VERSION: &str = "3.17.0";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (task, rest) = match args.split_first() {
+        Some((t, r)) => (t.as_str(), r),
+        None => ("help", &[][..]),
+    };
+    let result = match task {
+        "fetch" => fetch_mujoco().map(|_| ()),
+        "main" => fetch_mujoco().and_then(|_| run_main(rest)),
+        "test" => fetch_mujoco().and_then(|_| run_tests(rest)),
+        _ => {
+            eprintln!("usage: cargo xtask <fetch|main|test> [extra cargo args]");
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask {task}: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the workspace").to_path_buf()
+}
+
+/// Returns the folder that holds `libmujoco.so`, fetching the wheel if needed.
+/// A `MUJOCO_DYNAMIC_LINK_DIR` already in the environment (set by the user, not by our
+/// `.cargo/config.toml`, which cargo only applies to the processes it starts) is used as is.
+fn fetch_mujoco() -> Result<PathBuf, String> {
+    let root = workspace_root();
+    let lib_dir = root.join("vendor/mujoco/lib");
+    if let Ok(dir) = std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
+        let dir = PathBuf::from(dir);
+        if dir != lib_dir {
+            return if dir.join("libmujoco.so").is_file() {
+                Ok(dir)
+            } else {
+                Err(format!("MUJOCO_DYNAMIC_LINK_DIR={} holds no libmujoco.so", dir.display()))
+            };
+        }
+    }
+    let stamp = lib_dir.join(format!("libmujoco.so.{MUJOCO_VERSION}"));
+    if stamp.is_file() && lib_dir.join("libmujoco.so").exists() {
+        return Ok(lib_dir);
+    }
+    let wheel_dir = root.join("vendor/wheels");
+    eprintln!("xtask: fetching mujoco=={MUJOCO_VERSION} from PyPI (the wheel carries libmujoco.so)");
+    run(Command::new(python())
+        .args(["-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:"])
+        .arg(format!("mujoco=={MUJOCO_VERSION}"))
+        .arg("--dest")
+        .arg(&wheel_dir))?;
+    let wheel = std::fs::read_dir(&wheel_dir)
+        .map_err(|e| format!("{}: {e}", wheel_dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| {
+            let name = p.file_name().unwrap_or_default().to_string_lossy();
+            name.starts_with(&format!("mujoco-{MUJOCO_VERSION}-")) && name.ends_with(".whl")
+        })
+        .ok_or("pip downloaded no mujoco wheel")?;
+    // A wheel is a zip; Python's zipfile unpacks it without any extra tool on the machine.
+    let unpack = format!(
+        "import sys, zipfile, os\n\
+         z = zipfile.ZipFile(sys.argv[1]); out = sys.argv[2]; os.makedirs(out, exist_ok=True)\n\
+         for n in z.namelist():\n\
+         \x20   if not n.endswith('/') and (n.startswith('mujoco/libmujoco.so') or n.startswith('mujoco/plugin/')):\n\
+         \x20       dest = os.path.join(out, n[len('mujoco/'):])\n\
+         \x20       os.makedirs(os.path.dirname(dest), exist_ok=True)\n\
+         \x20       open(dest, 'wb').write(z.read(n))\n"
+    );
+    run(Command::new(python()).arg("-c").arg(unpack).arg(&wheel).arg(&lib_dir))?;
+    if !stamp.is_file() {
+        return Err(format!("the wheel {} holds no libmujoco.so.{MUJOCO_VERSION}", wheel.display()));
+    }
+    let link = lib_dir.join("libmujoco.so");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(format!("libmujoco.so.{MUJOCO_VERSION}"), &link)
+        .map_err(|e| format!("{}: {e}", link.display()))?;
+    eprintln!("xtask: MuJoCo {MUJOCO_VERSION} is in {}", lib_dir.display());
+    Ok(lib_dir)
+}
+
+fn python() -> String {
+    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+fn cargo() -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(workspace_root());
+    c
+}
+
+/// The main job: reproduce the paper's results with the twin.
+fn run_main(extra: &[String]) -> Result<(), String> {
+    let mut reproduce = cargo();
+    reproduce.args(["run", "--release", "--quiet", "--bin", "tendril", "--", "reproduce", "all"]).args(extra);
+    run(&mut reproduce)
+}
+
+/// The whole test suite (what `.ci/run` runs).
+fn run_tests(extra: &[String]) -> Result<(), String> {
+    run(cargo().args(["test", "--workspace", "--all-targets"]).args(extra))
+}
+
+fn run(cmd: &mut Command) -> Result<(), String> {
+    let status = cmd.status().map_err(|e| format!("cannot start {cmd:?}: {e}"))?;
+    if status.success() { Ok(()) } else { Err(format!("{cmd:?} failed ({status})")) }
+}
