@@ -76,7 +76,7 @@ fn fetch_mujoco() -> Result<PathBuf, String> {
         })
         .ok_or("pip downloaded no mujoco wheel")?;
     // A wheel is a zip; Python's zipfile unpacks it without any extra tool on the machine.
-    let unpack = format!(
+    let unpack = concat!(
         "import sys, zipfile, os\n\
          z = zipfile.ZipFile(sys.argv[1]); out = sys.argv[2]; os.makedirs(out, exist_ok=True)\n\
          for n in z.namelist():\n\
