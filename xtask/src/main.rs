@@ -76,16 +76,14 @@ fn fetch_mujoco() -> Result<PathBuf, String> {
         })
         .ok_or("pip downloaded no mujoco wheel")?;
     // A wheel is a zip; Python's zipfile unpacks it without any extra tool on the machine.
-    let unpack = concat!(
-        "import sys, zipfile, os\n\
+    const UNPACK: &str = "import sys, zipfile, os\n\
          z = zipfile.ZipFile(sys.argv[1]); out = sys.argv[2]; os.makedirs(out, exist_ok=True)\n\
          for n in z.namelist():\n\
          \x20   if not n.endswith('/') and (n.startswith('mujoco/libmujoco.so') or n.startswith('mujoco/plugin/')):\n\
          \x20       dest = os.path.join(out, n[len('mujoco/'):])\n\
          \x20       os.makedirs(os.path.dirname(dest), exist_ok=True)\n\
-         \x20       open(dest, 'wb').write(z.read(n))\n"
-    );
-    run(Command::new(python()).arg("-c").arg(unpack).arg(&wheel).arg(&lib_dir))?;
+         \x20       open(dest, 'wb').write(z.read(n))\n";
+    run(Command::new(python()).arg("-c").arg(UNPACK).arg(&wheel).arg(&lib_dir))?;
     if !stamp.is_file() {
         return Err(format!("the wheel {} holds no libmujoco.so.{MUJOCO_VERSION}", wheel.display()));
     }
