@@ -16,6 +16,7 @@
 //! - [`control`]: what runs the same on the twin and on the real cell.
 //! - [`calibration`]: the paper's calibration procedures, for simulated or recorded bench data.
 //! - [`reproduce`]: the paper's figures next to the twin's.
+//! - [`signals`]: the data types that cross the seam (wavelengths, ...).
 
 pub mod calibration;
 pub mod cell;
@@ -23,3 +24,4 @@ pub mod cli;
 pub mod control;
 pub mod reproduce;
 pub mod scenario;
+pub mod signals;
