@@ -22,6 +22,7 @@ pub mod calibration;
 pub mod cell;
 pub mod cli;
 pub mod control;
+pub mod hardware;
 pub mod reproduce;
 pub mod scenario;
 pub mod signals;

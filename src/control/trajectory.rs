@@ -1,0 +1,162 @@
+//! Joint-space point-to-point moves with a synchronised trapezoidal velocity profile.
+//!
+//! All joints start and stop together and follow the same normalised profile, so the tool moves
+//! along a straight line in joint space. The joint that travels furthest sets the profile; its
+//! speed and acceleration stay within [`JointLimits`] (the paper's transfer: 45 °/s, 15 °/s²).
+
+use crate::hardware::ARM_JOINTS;
+use crate::scenario::{Checker, Validate};
+use serde::{Deserialize, Serialize};
+
+/// Per-joint speed and acceleration bounds (TOML `[task.limits]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct JointLimits {
+    /// Largest joint speed [°/s]. Paper Sec. V-B: 45.
+    pub max_speed_deg_s: f64,
+    /// Largest joint acceleration [°/s²]. Paper Sec. V-B: 15.
+    pub max_accel_deg_s2: f64,
+}
+
+impl Default for JointLimits {
+    fn default() -> Self {
+        JointLimits { max_speed_deg_s: 45.0, max_accel_deg_s2: 15.0 }
+    }
+}
+
+impl Validate for JointLimits {
+    fn validate(&self, at: &mut Checker) {
+        // The UR5e's joints reach 180 °/s (hardware.md); faster targets would not be followed.
+        at.in_range("max_speed_deg_s", self.max_speed_deg_s, 1e-3, 180.0);
+        at.positive("max_accel_deg_s2", self.max_accel_deg_s2);
+    }
+}
+
+/// A planned move from one joint configuration to another.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointMove {
+    from: [f64; ARM_JOINTS],
+    to: [f64; ARM_JOINTS],
+    duration_s: f64,
+    /// Time spent accelerating (and, symmetrically, decelerating) [s].
+    ramp_s: f64,
+    /// Peak rate of the normalised path parameter s ∈ [0, 1] [1/s].
+    peak_rate: f64,
+}
+
+impl JointMove {
+    /// Plans the fastest move within `limits` that lasts at least `min_duration_s`.
+    /// Angles in radians.
+    pub fn plan(from: [f64; ARM_JOINTS], to: [f64; ARM_JOINTS], limits: &JointLimits, min_duration_s: f64) -> JointMove {
+        let span = from.iter().zip(&to).map(|(a, b)| (b - a).abs()).fold(0.0, f64::max);
+        if span == 0.0 {
+            return JointMove { from, to, duration_s: min_duration_s.max(0.0), ramp_s: 0.0, peak_rate: 0.0 };
+        }
+        let v = limits.max_speed_deg_s.to_radians() / span; // normalised speed limit [1/s]
+        let a = limits.max_accel_deg_s2.to_radians() / span; // normalised acceleration limit [1/s²]
+        // Fastest profile: triangular when the speed limit is never reached, trapezoidal otherwise.
+        let fastest = if v * v / a >= 1.0 { 2.0 / a.sqrt() } else { 1.0 / v + v / a };
+        let duration_s = fastest.max(min_duration_s);
+        // Cruise rate w for this duration at full acceleration: 1 = w (T − w / a).
+        let disc = (a * duration_s).powi(2) - 4.0 * a;
+        let peak_rate = (a * duration_s - disc.max(0.0).sqrt()) / 2.0;
+        JointMove { from, to, duration_s, ramp_s: peak_rate / a, peak_rate }
+    }
+
+    /// How long the move takes [s].
+    pub fn duration_s(&self) -> f64 {
+        self.duration_s
+    }
+
+    /// The target configuration.
+    pub fn end(&self) -> [f64; ARM_JOINTS] {
+        self.to
+    }
+
+    /// Path parameter s ∈ [0, 1] and its rate at time `t` after the start.
+    fn progress(&self, t: f64) -> (f64, f64) {
+        if self.peak_rate == 0.0 {
+            return (if t >= self.duration_s { 1.0 } else { 0.0 }, 0.0);
+        }
+        let (w, ta, tt) = (self.peak_rate, self.ramp_s, self.duration_s);
+        let a = w / ta;
+        let t = t.clamp(0.0, tt);
+        if t < ta {
+            (0.5 * a * t * t, a * t)
+        } else if t <= tt - ta {
+            (0.5 * a * ta * ta + w * (t - ta), w)
+        } else {
+            let left = tt - t;
+            (1.0 - 0.5 * a * left * left, a * left)
+        }
+    }
+
+    /// Joint positions [rad] and velocities [rad/s] at time `t` after the start.
+    pub fn sample(&self, t: f64) -> ([f64; ARM_JOINTS], [f64; ARM_JOINTS]) {
+        let (s, rate) = self.progress(t);
+        let mut q = [0.0; ARM_JOINTS];
+        let mut qd = [0.0; ARM_JOINTS];
+        for j in 0..ARM_JOINTS {
+            let delta = self.to[j] - self.from[j];
+            q[j] = self.from[j] + s * delta;
+            qd[j] = rate * delta;
+        }
+        (q, qd)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DEG: f64 = std::f64::consts::PI / 180.0;
+
+    fn peak_speed_and_accel(m: &JointMove) -> (f64, f64) {
+        let dt = 1e-3;
+        let (mut vmax, mut amax, mut prev) = (0.0f64, 0.0f64, 0.0);
+        let mut t = 0.0;
+        while t <= m.duration_s() {
+            let v = m.sample(t).1.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            vmax = vmax.max(v);
+            if t > 0.0 {
+                amax = amax.max((v - prev).abs() / dt);
+            }
+            prev = v;
+            t += dt;
+        }
+        (vmax / DEG, amax / DEG)
+    }
+
+    #[test]
+    fn long_move_cruises_at_the_speed_limit() {
+        let to = [180.0 * DEG, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let m = JointMove::plan([0.0; 6], to, &JointLimits::default(), 0.0);
+        // Two 3 s ramps cover 135°, the remaining 45° at 45 °/s take 1 s.
+        assert!((m.duration_s() - 7.0).abs() < 1e-9, "{}", m.duration_s());
+        let (v, a) = peak_speed_and_accel(&m);
+        assert!((v - 45.0).abs() < 0.1 && a <= 15.0 + 0.1, "v {v} a {a}");
+        assert_eq!(m.sample(m.duration_s()).0, to);
+    }
+
+    #[test]
+    fn short_move_is_triangular_and_slow_moves_stretch() {
+        let to = [0.0, 20.0 * DEG, -10.0 * DEG, 0.0, 0.0, 0.0];
+        let m = JointMove::plan([0.0; 6], to, &JointLimits::default(), 0.0);
+        assert!((m.duration_s() - 2.0 * (20.0f64 / 15.0).sqrt()).abs() < 1e-9);
+        let slow = JointMove::plan([0.0; 6], to, &JointLimits::default(), 10.0);
+        assert_eq!(slow.duration_s(), 10.0);
+        let (v, a) = peak_speed_and_accel(&slow);
+        assert!(v < 45.0 && a <= 15.1, "v {v} a {a}");
+        // Joints stay synchronised: the second joint is always at minus half the first.
+        let (q, _) = slow.sample(3.3);
+        assert!((q[2] + 0.5 * q[1]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn zero_move_holds_still_for_its_duration() {
+        let q = [0.1; 6];
+        let m = JointMove::plan(q, q, &JointLimits::default(), 2.0);
+        assert_eq!(m.duration_s(), 2.0);
+        assert_eq!(m.sample(1.0), (q, [0.0; 6]));
+    }
+}

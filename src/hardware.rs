@@ -1,0 +1,126 @@
+//! The seam between the cell (simulated or real) and the shared control code.
+//!
+//! Modelled on ros2_control: a [`Cell`] is brought up through an explicit lifecycle
+//! (`configure` → `activate` → … → `deactivate`), and every control tick is
+//! [`Cell::read`] → (controller update, above the trait) → [`Cell::write`] → [`Cell::wait_until`].
+//! Time comes from the cell: a simulation steps its physics in `wait_until`, a real cell sleeps.
+//! Code above this trait must not know which cell it runs on.
+
+use crate::signals::Wavelengths;
+use serde::Serialize;
+
+/// Number of UR5e joints.
+pub const ARM_JOINTS: usize = 6;
+
+/// The lifecycle states of a cell (ros2_control's managed-node states, minus error handling).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Lifecycle {
+    /// Created; devices not yet contacted / scene not yet built.
+    Unconfigured,
+    /// Devices reached and checked, outputs disabled (motors unpowered, arm not following).
+    Inactive,
+    /// Commands are executed.
+    Active,
+}
+
+/// What the cell reports at each tick. All angles in radians.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CellState {
+    /// Cell time in seconds since activation (simulated or wall clock).
+    pub time_s: f64,
+    /// Measured arm joint positions [rad].
+    pub arm_q: [f64; ARM_JOINTS],
+    /// Measured growth motor position [rad] (the MX-106 feeding the strip out).
+    pub growth_motor_rad: f64,
+    /// Measured twine motor position [rad] (the MX-106 pulling the curl tendon).
+    pub twine_motor_rad: f64,
+    /// The latest interrogator sample.
+    pub wavelengths: Wavelengths,
+}
+
+/// What the control code asks of the cell at each tick. Position targets, radians.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CellCommand {
+    /// Arm joint position targets [rad]; the caller keeps them within speed and acceleration limits.
+    pub arm_q: [f64; ARM_JOINTS],
+    /// Growth motor position target [rad].
+    pub growth_motor_rad: f64,
+    /// Twine motor position target [rad].
+    pub twine_motor_rad: f64,
+}
+
+/// Quantities only a simulation knows; logged in traces when the cell offers them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+pub struct GroundTruth {
+    /// True normal force on the sensor bump [N].
+    pub sensor_force_n: f64,
+    /// Total normal force between finger and object [N].
+    pub grip_force_n: f64,
+    /// Height of the object's centre of mass above the table top [m].
+    pub object_height_m: f64,
+    /// Speed of the object relative to the hand [m/s].
+    pub slip_speed_m_s: f64,
+    /// Whether the finger (or pad) touches the object at all.
+    pub in_contact: bool,
+}
+
+/// Why a cell operation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CellError {
+    /// A lifecycle method was called in the wrong state.
+    #[error("cannot {action} a cell that is {state:?}")]
+    Lifecycle {
+        /// What was attempted.
+        action: &'static str,
+        /// The state the cell was in.
+        state: Lifecycle,
+    },
+    /// The physics diverged or failed; `time_s` is when it was detected.
+    #[error("physics failed at t = {time_s:.4} s: {cause}")]
+    Physics {
+        /// Simulated time of detection [s].
+        time_s: f64,
+        /// What went wrong.
+        cause: String,
+    },
+    /// A device did not answer or answered wrongly.
+    #[error("device {device}: {cause}")]
+    Device {
+        /// Which device.
+        device: String,
+        /// What went wrong.
+        cause: String,
+    },
+    /// Set-up failed (scene could not be built, device not found...).
+    #[error("configure: {0}")]
+    Configure(String),
+}
+
+/// A gripping cell: arm, gripper motors and interrogator behind one lifecycle.
+pub trait Cell {
+    /// A short name for summaries (`"mujoco"`, `"real"`).
+    fn backend(&self) -> &str;
+    /// The current lifecycle state.
+    fn lifecycle(&self) -> Lifecycle;
+    /// Unconfigured → Inactive: build the scene / connect to the devices and check them.
+    fn configure(&mut self) -> Result<(), CellError>;
+    /// Inactive → Active: enable outputs; cell time starts at 0.
+    fn activate(&mut self) -> Result<(), CellError>;
+    /// Active → Inactive: stop the arm, leave the motors holding, disable outputs. Safe to call on error paths.
+    fn deactivate(&mut self) -> Result<(), CellError>;
+    /// Reads the latest state (Active only).
+    fn read(&mut self) -> Result<CellState, CellError>;
+    /// Sends position targets (Active only).
+    fn write(&mut self, command: &CellCommand) -> Result<(), CellError>;
+    /// Lets time pass until cell time `time_s`: a simulation steps, a real cell sleeps.
+    fn wait_until(&mut self, time_s: f64) -> Result<(), CellError>;
+    /// Ground truth, when the cell is a simulation.
+    fn ground_truth(&self) -> Option<GroundTruth> {
+        None
+    }
+}
+
+/// Checks a lifecycle transition: `Ok` when the cell is in `expected`.
+pub fn require_state(current: Lifecycle, expected: Lifecycle, action: &'static str) -> Result<(), CellError> {
+    if current == expected { Ok(()) } else { Err(CellError::Lifecycle { action, state: current }) }
+}
