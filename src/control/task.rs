@@ -1,0 +1,383 @@
+//! The paper's pick-and-place sequence (Sec. V-B, Fig. 6) as a time- and event-driven state
+//! machine: home → grow → wrap → grasp under force control → lift → transfer → lower → release.
+//!
+//! Each tick the sequencer takes the cell's state and the force estimate and returns the
+//! command. It never sees the true force: control runs on the sensor, as on the real cell.
+
+use super::gripper::GripperConfig;
+use super::pid::Pid;
+use super::trajectory::{JointLimits, JointMove};
+use crate::hardware::{ARM_JOINTS, CellCommand, CellState};
+use crate::scenario::{Checker, Validate};
+use serde::{Deserialize, Serialize};
+
+/// The phases of the task, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// Arm at home above the object, finger retracted; the sensor is tared here.
+    Home,
+    /// The finger is fed out of its guide.
+    Grow,
+    /// Guarded close: the twine motor curls the finger until the sensor feels contact.
+    Wrap,
+    /// Force control to the setpoint for the grasp period.
+    Grasp,
+    /// The arm lifts the object.
+    Lift,
+    /// The arm carries the object to the collection site.
+    Transfer,
+    /// The arm lowers the object at the collection site.
+    Lower,
+    /// The finger uncurls and lets go.
+    Release,
+    /// Finished.
+    Done,
+}
+
+impl Phase {
+    /// Lower-case name, as written in traces and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Home => "home",
+            Phase::Grow => "grow",
+            Phase::Wrap => "wrap",
+            Phase::Grasp => "grasp",
+            Phase::Lift => "lift",
+            Phase::Transfer => "transfer",
+            Phase::Lower => "lower",
+            Phase::Release => "release",
+            Phase::Done => "done",
+        }
+    }
+
+    /// Whether the arm is moving the object (the paper's "during the movement").
+    pub fn arm_moving(self) -> bool {
+        matches!(self, Phase::Lift | Phase::Transfer | Phase::Lower)
+    }
+
+    /// Whether the object must be in the hand (from the end of the grasp to the release).
+    pub fn holding(self) -> bool {
+        matches!(self, Phase::Grasp | Phase::Lift | Phase::Transfer | Phase::Lower)
+    }
+}
+
+/// The task's poses and timing (TOML `[task]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TaskConfig {
+    /// Home pose above the object [°]: the UR5e's common home (hardware.md).
+    pub home_deg: [f64; ARM_JOINTS],
+    /// Pose at the top of the lift [°]: shoulder and elbow raise the tool about 15 cm.
+    pub lift_deg: [f64; ARM_JOINTS],
+    /// Pose above the collection site [°]: base turned 60° from the lift pose.
+    pub transfer_deg: [f64; ARM_JOINTS],
+    /// Pose at the collection site [°]: the lift reversed at the new base angle.
+    pub place_deg: [f64; ARM_JOINTS],
+    /// Time at home before growing, while the sensor is tared [s].
+    pub settle_s: f64,
+    /// Finger growth [m]. Paper Sec. V-B: 14.0 cm.
+    pub growth_m: f64,
+    /// Growth feed speed [m/s]. 5 cm/s is a quarter of what the MX-106 (45 rpm) gives on a
+    /// 12 mm pinion, a gentle feed for a soft strip.
+    pub growth_speed_m_s: f64,
+    /// Twine speed of the guarded close before force control [°/s].
+    pub wrap_speed_deg_s: f64,
+    /// Force estimate that ends the guarded close [N]: first contact, 4× the detector's floor.
+    pub wrap_contact_n: f64,
+    /// Longest guarded close [s]; past it the grasp starts anyway (and will likely fail).
+    pub wrap_timeout_s: f64,
+    /// Grasp period under force control before the arm moves [s]. Paper Sec. V-B: 15 s.
+    pub grasp_s: f64,
+    /// Shortest lift duration [s]. The paper reports the crimper dropping "during the upward
+    /// motion" at ≈ 10 s after the arm started: the lift lasts 11 s.
+    pub lift_s: f64,
+    /// Shortest transfer duration [s]: the shampoo bottle slips "during the horizontal transfer"
+    /// at ≈ 13 s, so the transfer spans 11-16 s.
+    pub transfer_s: f64,
+    /// Shortest lowering duration [s]: the hammer falls "as the arm approaches the collection
+    /// site" at ≈ 17 s, so the approach spans 16-21 s.
+    pub lower_s: f64,
+    /// Time to uncurl the finger at the end [s].
+    pub release_s: f64,
+    /// Joint speed and acceleration limits during the moves.
+    pub limits: JointLimits,
+}
+
+impl Default for TaskConfig {
+    fn default() -> Self {
+        TaskConfig {
+            home_deg: [-90.0, -90.0, 90.0, -90.0, -90.0, 0.0],
+            lift_deg: [-90.0, -100.0, 80.0, -70.0, -90.0, 0.0],
+            transfer_deg: [-30.0, -100.0, 80.0, -70.0, -90.0, 0.0],
+            place_deg: [-30.0, -90.0, 90.0, -90.0, -90.0, 0.0],
+            settle_s: 0.5,
+            growth_m: 0.14,
+            growth_speed_m_s: 0.05,
+            wrap_speed_deg_s: 45.0,
+            wrap_contact_n: 0.2,
+            wrap_timeout_s: 20.0,
+            grasp_s: 15.0,
+            lift_s: 11.0,
+            transfer_s: 5.0,
+            lower_s: 5.0,
+            release_s: 2.0,
+            limits: JointLimits::default(),
+        }
+    }
+}
+
+impl Validate for TaskConfig {
+    fn validate(&self, at: &mut Checker) {
+        for (name, pose) in [
+            ("home_deg", &self.home_deg),
+            ("lift_deg", &self.lift_deg),
+            ("transfer_deg", &self.transfer_deg),
+            ("place_deg", &self.place_deg),
+        ] {
+            // UR5e joint limits ±360° (hardware.md).
+            at.require(name, pose.iter().all(|q| q.is_finite() && q.abs() <= 360.0), || {
+                format!("every joint angle must lie within ±360°, got {pose:?}")
+            });
+        }
+        at.non_negative("settle_s", self.settle_s);
+        at.in_range("growth_m", self.growth_m, 0.0, 0.3);
+        at.positive("growth_speed_m_s", self.growth_speed_m_s);
+        at.positive("wrap_speed_deg_s", self.wrap_speed_deg_s);
+        at.positive("wrap_contact_n", self.wrap_contact_n);
+        at.positive("wrap_timeout_s", self.wrap_timeout_s);
+        at.non_negative("grasp_s", self.grasp_s);
+        at.non_negative("lift_s", self.lift_s);
+        at.non_negative("transfer_s", self.transfer_s);
+        at.non_negative("lower_s", self.lower_s);
+        at.non_negative("release_s", self.release_s);
+        at.section("limits", &self.limits);
+    }
+}
+
+/// What the sequencer decided this tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TickDecision {
+    /// The command for the cell.
+    pub command: CellCommand,
+    /// The phase this tick belongs to.
+    pub phase: Phase,
+    /// The force controller's output [°/s], 0 when it is off.
+    pub controller_output_deg_s: f64,
+    /// Whether the force controller ran this tick.
+    pub controller_on: bool,
+}
+
+/// Runs the task. Create one per run.
+#[derive(Debug, Clone)]
+pub struct TaskSequencer {
+    task: TaskConfig,
+    gripper: GripperConfig,
+    pid: Pid,
+    setpoint_n: f64,
+    feedback_while_moving: bool,
+    phase: Phase,
+    phase_start_s: f64,
+    arm_move: Option<JointMove>,
+    twine_deg: f64,
+    growth_m: f64,
+    motion_start_s: Option<f64>,
+}
+
+fn radians(deg: &[f64; ARM_JOINTS]) -> [f64; ARM_JOINTS] {
+    deg.map(f64::to_radians)
+}
+
+impl TaskSequencer {
+    /// A sequencer at the start of the task. `feedback_while_moving` keeps the force
+    /// controller on during the arm's moves (the paper's second mode) or switches it off
+    /// before the arm moves (the first mode).
+    pub fn new(task: TaskConfig, gripper: GripperConfig, pid: Pid, setpoint_n: f64, feedback_while_moving: bool) -> Self {
+        TaskSequencer {
+            task,
+            gripper,
+            pid,
+            setpoint_n,
+            feedback_while_moving,
+            phase: Phase::Home,
+            phase_start_s: 0.0,
+            arm_move: None,
+            twine_deg: 0.0,
+            growth_m: 0.0,
+            motion_start_s: None,
+        }
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The force setpoint [N].
+    pub fn setpoint_n(&self) -> f64 {
+        self.setpoint_n
+    }
+
+    /// Cell time at which the arm started to move the object [s], once it has.
+    pub fn motion_start_s(&self) -> Option<f64> {
+        self.motion_start_s
+    }
+
+    fn enter(&mut self, phase: Phase, now: f64, arm_q: [f64; ARM_JOINTS]) {
+        self.phase = phase;
+        self.phase_start_s = now;
+        let t = &self.task;
+        let target = match phase {
+            Phase::Lift => Some((&t.lift_deg, t.lift_s)),
+            Phase::Transfer => Some((&t.transfer_deg, t.transfer_s)),
+            Phase::Lower => Some((&t.place_deg, t.lower_s)),
+            _ => None,
+        };
+        self.arm_move = target.map(|(pose, min_s)| JointMove::plan(arm_q, radians(pose), &t.limits, min_s));
+        if phase == Phase::Lift {
+            self.motion_start_s = Some(now);
+            if !self.feedback_while_moving {
+                self.pid.reset();
+            }
+        }
+        if phase == Phase::Grasp {
+            self.pid.reset();
+        }
+    }
+
+    /// One tick: `force_n` is the compensated force estimate, `dt_s` the tick period.
+    pub fn update(&mut self, state: &CellState, force_n: f64, dt_s: f64) -> TickDecision {
+        let now = state.time_s;
+        let elapsed = now - self.phase_start_s;
+        let arm_target = self.arm_move.as_ref().map(|m| m.end());
+        let next = match self.phase {
+            Phase::Home if elapsed >= self.task.settle_s => Some(Phase::Grow),
+            Phase::Grow if self.growth_m >= self.task.growth_m => Some(Phase::Wrap),
+            Phase::Wrap if force_n >= self.task.wrap_contact_n || elapsed >= self.task.wrap_timeout_s => {
+                Some(Phase::Grasp)
+            }
+            Phase::Grasp if elapsed >= self.task.grasp_s => Some(Phase::Lift),
+            Phase::Lift | Phase::Transfer | Phase::Lower
+                if self.arm_move.as_ref().is_some_and(|m| elapsed >= m.duration_s()) =>
+            {
+                Some(match self.phase {
+                    Phase::Lift => Phase::Transfer,
+                    Phase::Transfer => Phase::Lower,
+                    _ => Phase::Release,
+                })
+            }
+            Phase::Release if elapsed >= self.task.release_s => Some(Phase::Done),
+            _ => None,
+        };
+        if let Some(phase) = next {
+            // Chain moves from the planned end pose, not the measured one, so small tracking
+            // errors do not accumulate into the plan.
+            self.enter(phase, now, arm_target.unwrap_or(state.arm_q));
+        }
+        let elapsed = now - self.phase_start_s;
+
+        let arm_q = match (&self.arm_move, self.phase) {
+            (Some(m), _) => m.sample(elapsed).0,
+            (None, Phase::Home | Phase::Grow | Phase::Wrap | Phase::Grasp) => radians(&self.task.home_deg),
+            (None, _) => radians(&self.task.place_deg),
+        };
+
+        let mut controller_output = 0.0;
+        let controller_on = match self.phase {
+            Phase::Grasp => true,
+            p if p.arm_moving() => self.feedback_while_moving,
+            _ => false,
+        };
+        match self.phase {
+            Phase::Grow => self.growth_m = (self.growth_m + self.task.growth_speed_m_s * dt_s).min(self.task.growth_m),
+            Phase::Wrap => self.twine_deg += self.task.wrap_speed_deg_s * dt_s,
+            Phase::Release => self.twine_deg = (self.twine_deg - self.pid.config().max_speed_deg_s * dt_s).max(0.0),
+            _ => {}
+        }
+        if controller_on {
+            // The integral must not wind up while the tendon is at a travel limit it pushes against.
+            let tighten = self.setpoint_n > force_n;
+            let blocked = (tighten && self.twine_deg >= self.gripper.twine_max_deg) || (!tighten && self.twine_deg <= 0.0);
+            controller_output = self.pid.update(self.setpoint_n, force_n, dt_s, blocked);
+            self.twine_deg += controller_output * dt_s;
+        }
+        self.twine_deg = self.twine_deg.clamp(0.0, self.gripper.twine_max_deg);
+
+        TickDecision {
+            command: CellCommand {
+                arm_q,
+                growth_motor_rad: self.gripper.growth_motor_rad(self.growth_m),
+                twine_motor_rad: self.twine_deg.to_radians(),
+            },
+            phase: self.phase,
+            controller_output_deg_s: controller_output,
+            controller_on,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::pid::PidConfig;
+    use crate::signals::Wavelengths;
+
+    /// A toy plant: force grows linearly with twine past first contact at 60°, and relaxes by
+    /// `creep_n_s` per second; returns (phases seen in order, final twine °, force trace).
+    fn run_toy(feedback: bool, creep_n_s: f64) -> (Vec<Phase>, Vec<(f64, Phase, f64)>) {
+        let task = TaskConfig::default();
+        let gripper = GripperConfig::default();
+        let mut seq = TaskSequencer::new(task, gripper, Pid::new(PidConfig::default()), 1.0, feedback);
+        let dt = 0.01;
+        let mut twine_deg: f64 = 0.0;
+        let mut offset: f64 = 0.0;
+        let mut phases = vec![];
+        let mut trace = vec![];
+        let mut arm_q = [0.0; ARM_JOINTS];
+        for i in 0..10_000 {
+            let t = i as f64 * dt;
+            let force = (0.02 * (twine_deg - 60.0) - offset).max(0.0);
+            let state = CellState {
+                time_s: t,
+                arm_q,
+                growth_motor_rad: 0.0,
+                twine_motor_rad: twine_deg.to_radians(),
+                wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+            };
+            let d = seq.update(&state, force, dt);
+            if phases.last() != Some(&d.phase) {
+                phases.push(d.phase);
+            }
+            trace.push((t, d.phase, force));
+            twine_deg = d.command.twine_motor_rad.to_degrees();
+            arm_q = d.command.arm_q;
+            if force > 0.0 {
+                offset += creep_n_s * dt;
+            }
+            if d.phase == Phase::Done {
+                break;
+            }
+        }
+        (phases, trace)
+    }
+
+    #[test]
+    fn phases_run_in_order_and_the_grasp_converges() {
+        let (phases, trace) = run_toy(true, 0.0);
+        use Phase::*;
+        assert_eq!(phases, vec![Home, Grow, Wrap, Grasp, Lift, Transfer, Lower, Release, Done]);
+        let grasp_end = trace.iter().rfind(|(_, p, _)| *p == Grasp).unwrap();
+        assert!((grasp_end.2 - 1.0).abs() < 0.02, "force at end of grasp {}", grasp_end.2);
+    }
+
+    #[test]
+    fn without_feedback_the_twine_is_frozen_while_the_arm_moves() {
+        let (_, with) = run_toy(true, 0.05);
+        let (_, without) = run_toy(false, 0.05);
+        let last_moving = |tr: &[(f64, Phase, f64)]| tr.iter().rfind(|(_, p, _)| p.arm_moving()).unwrap().2;
+        // Creep erodes the open-loop grip; the closed loop holds it near the setpoint, short by
+        // the ramp-following error of an integrating loop: 0.05 N/s / (Kp 20 × 0.02 N/°) = 0.125 N.
+        assert!(last_moving(&without) < 0.3, "{}", last_moving(&without));
+        assert!((last_moving(&with) - 0.875).abs() < 0.05, "{}", last_moving(&with));
+    }
+}
