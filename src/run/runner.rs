@@ -1,0 +1,214 @@
+//! The control loop over any [`Cell`]: read → estimate → sequence/control → write → wait.
+//!
+//! This is the code that runs unchanged on the twin and on the real cell.
+
+use super::metrics::{ControlMetrics, control_metrics};
+use super::trace::{TraceRow, TraceWriter};
+use crate::control::estimate::{ForceCalibration, ForceEstimator};
+use crate::control::pid::{Pid, PidConfig};
+use crate::control::slip::{SlipConfig, SlipDetector, SlipEvents};
+use crate::control::task::{Phase, TaskConfig, TaskSequencer};
+use crate::control::gripper::GripperConfig;
+use crate::hardware::{Cell, CellError};
+use crate::signals::Wavelengths;
+use serde::Serialize;
+
+/// Everything the control side needs for one run (the cell is configured separately).
+#[derive(Debug, Clone)]
+pub struct ControlPlan {
+    /// Force setpoint [N].
+    pub setpoint_n: f64,
+    /// Keep force control on while the arm moves.
+    pub feedback: bool,
+    /// Control loop rate [Hz].
+    pub rate_hz: f64,
+    /// PID gains and limits.
+    pub pid: PidConfig,
+    /// Calibration used by the estimator (eq. 8).
+    pub calibration: ForceCalibration,
+    /// Poses and timing.
+    pub task: TaskConfig,
+    /// Drive-train geometry.
+    pub gripper: GripperConfig,
+    /// Slip detector thresholds.
+    pub slip: SlipConfig,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// The object stayed in the hand until the release.
+    Held,
+    /// The object was lost before the release.
+    Dropped,
+    /// The run stopped on an error (physics divergence, device fault).
+    Error,
+}
+
+/// When and where the object was lost.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Drop {
+    /// Cell time of the loss [s].
+    pub cell_time_s: f64,
+    /// Phase in which it happened.
+    pub phase: Phase,
+}
+
+/// The result of a run: outcome, events and metrics; the rows are kept for plotting.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// Held, dropped or error.
+    pub outcome: Outcome,
+    /// The loss, if any (from ground truth when the cell has it, else from the sensor).
+    pub drop: Option<Drop>,
+    /// Cell time when the arm started moving the object [s].
+    pub motion_start_s: Option<f64>,
+    /// What the sensor-based slip detector saw.
+    pub slip: SlipEvents,
+    /// Rise time, overshoot, fluctuation, estimate error.
+    pub metrics: ControlMetrics,
+    /// Cell time reached [s].
+    pub cell_time_s: f64,
+    /// The error that ended the run, with its time.
+    pub error: Option<String>,
+    /// Every tick, as written to the trace.
+    pub rows: Vec<TraceRow>,
+}
+
+/// Ground truth must say "no contact" this long before the object counts as lost [s]:
+/// a contact flickering during a slip is not yet a drop.
+const LOST_CONTACT_S: f64 = 0.3;
+
+/// Runs the task on `cell`, writing each tick to `trace` when given. The cell is configured,
+/// activated and, whatever happens, deactivated. Cell errors end the run with
+/// [`Outcome::Error`]; the rows up to the error are kept.
+pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut TraceWriter>) -> RunReport {
+    let mut rows = Vec::new();
+    let mut sequencer = TaskSequencer::new(
+        plan.task.clone(),
+        plan.gripper,
+        Pid::new(plan.pid),
+        plan.setpoint_n,
+        plan.feedback,
+    );
+    let mut slip = SlipDetector::new(plan.slip);
+    let mut truth_drop: Option<Drop> = None;
+    let mut no_contact_since: Option<f64> = None;
+    let dt = 1.0 / plan.rate_hz;
+
+    let mut run = || -> Result<(), CellError> {
+        cell.configure()?;
+        cell.activate()?;
+        let mut estimator = ForceEstimator::new(plan.calibration);
+        let mut tare = TareAverager::default();
+        for tick in 0u64.. {
+            let state = cell.read()?;
+            if sequencer.phase() == Phase::Home {
+                // Tare on the mean of the samples at home, finger retracted and untouched.
+                tare.add(state.wavelengths);
+                estimator.tare(tare.mean());
+            }
+            let estimate = estimator.estimate(state.wavelengths).map_err(|e| CellError::Device {
+                device: "estimator".into(),
+                cause: format!("at t = {:.3} s: {e}", state.time_s),
+            })?;
+            let decision = sequencer.update(&state, estimate.force_n, dt);
+            slip.update(state.time_s, estimate.force_n, plan.setpoint_n, decision.phase.holding());
+            cell.write(&decision.command)?;
+
+            let truth = cell.ground_truth();
+            if let Some(t) = truth {
+                let watching = decision.phase.holding() && decision.phase != Phase::Grasp;
+                if watching && !t.in_contact && truth_drop.is_none() {
+                    let since = *no_contact_since.get_or_insert(state.time_s);
+                    if state.time_s - since >= LOST_CONTACT_S {
+                        truth_drop = Some(Drop { cell_time_s: since, phase: phase_at(&rows, since) });
+                    }
+                } else {
+                    no_contact_since = None;
+                }
+            }
+            let nan = f64::NAN;
+            let row = TraceRow {
+                time_s: state.time_s,
+                phase: decision.phase,
+                true_force_n: truth.map_or(nan, |t| t.sensor_force_n),
+                fbg1_nm: state.wavelengths.fbg1_nm,
+                fbg2_nm: state.wavelengths.fbg2_nm,
+                force_n: estimate.force_n,
+                force_uncompensated_n: estimate.uncompensated_n,
+                over_range: estimate.over_range,
+                setpoint_n: plan.setpoint_n,
+                controller_on: decision.controller_on,
+                controller_output_deg_s: decision.controller_output_deg_s,
+                growth_motor_rad: state.growth_motor_rad,
+                twine_motor_rad: state.twine_motor_rad,
+                object_height_m: truth.map_or(nan, |t| t.object_height_m),
+                slip_speed_m_s: truth.map_or(nan, |t| t.slip_speed_m_s),
+                grip_force_n: truth.map_or(nan, |t| t.grip_force_n),
+            };
+            if let Some(w) = trace.as_deref_mut() {
+                w.write(&row).map_err(|e| CellError::Device { device: "trace".into(), cause: e.to_string() })?;
+            }
+            rows.push(row);
+            if decision.phase == Phase::Done {
+                return Ok(());
+            }
+            cell.wait_until((tick + 1) as f64 * dt)?;
+        }
+        Ok(())
+    };
+    let result = run();
+    let stop = cell.deactivate();
+    if let Some(w) = trace {
+        let _ = w.flush();
+    }
+    let error = result.err().or(stop.err()).map(|e| e.to_string());
+
+    let sensor_drop = slip.events().lost_s.map(|t| Drop { cell_time_s: t, phase: phase_at(&rows, t) });
+    let has_truth = rows.first().is_some_and(|r| r.true_force_n.is_finite());
+    let drop = if has_truth { truth_drop } else { sensor_drop };
+    let outcome = match (&error, drop) {
+        (Some(_), _) => Outcome::Error,
+        (None, Some(_)) => Outcome::Dropped,
+        (None, None) => Outcome::Held,
+    };
+    let metrics = control_metrics(&rows, drop.map(|d| d.cell_time_s));
+    RunReport {
+        outcome,
+        drop,
+        motion_start_s: sequencer.motion_start_s(),
+        slip: slip.events(),
+        metrics,
+        cell_time_s: rows.last().map_or(0.0, |r| r.time_s),
+        error,
+        rows,
+    }
+}
+
+/// The phase of the last row at or before `time_s`.
+fn phase_at(rows: &[TraceRow], time_s: f64) -> Phase {
+    rows.iter().rev().find(|r| r.time_s <= time_s).map_or(Phase::Home, |r| r.phase)
+}
+
+/// Running mean of wavelength samples, for the tare.
+#[derive(Debug, Default)]
+struct TareAverager {
+    sum1: f64,
+    sum2: f64,
+    n: u32,
+}
+
+impl TareAverager {
+    fn add(&mut self, w: Wavelengths) {
+        self.sum1 += w.fbg1_nm;
+        self.sum2 += w.fbg2_nm;
+        self.n += 1;
+    }
+
+    fn mean(&self) -> Wavelengths {
+        let n = f64::from(self.n.max(1));
+        Wavelengths { fbg1_nm: self.sum1 / n, fbg2_nm: self.sum2 / n }
+    }
+}

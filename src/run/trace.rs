@@ -1,0 +1,88 @@
+//! `trace.csv`: one row per control tick, streamed to disk as the run goes.
+
+use crate::control::task::Phase;
+use std::io::Write;
+use std::path::Path;
+
+/// One control tick, as written to `trace.csv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceRow {
+    /// Cell time [s].
+    pub time_s: f64,
+    /// Task phase.
+    pub phase: Phase,
+    /// True normal force on the sensor [N] (NaN when the cell has no ground truth).
+    pub true_force_n: f64,
+    /// FBG1 peak [nm].
+    pub fbg1_nm: f64,
+    /// FBG2 peak [nm].
+    pub fbg2_nm: f64,
+    /// Temperature-compensated force estimate, eq. (8) [N].
+    pub force_n: f64,
+    /// Estimate without temperature compensation [N].
+    pub force_uncompensated_n: f64,
+    /// Whether the estimate was flagged over range.
+    pub over_range: bool,
+    /// Force setpoint [N].
+    pub setpoint_n: f64,
+    /// Whether the force controller ran.
+    pub controller_on: bool,
+    /// Controller output: twine motor speed [°/s].
+    pub controller_output_deg_s: f64,
+    /// Growth motor position [rad].
+    pub growth_motor_rad: f64,
+    /// Twine motor position [rad].
+    pub twine_motor_rad: f64,
+    /// Object height above the table [m] (NaN without ground truth).
+    pub object_height_m: f64,
+    /// Object speed relative to the hand [m/s] (NaN without ground truth).
+    pub slip_speed_m_s: f64,
+    /// Total grip normal force [N] (NaN without ground truth).
+    pub grip_force_n: f64,
+}
+
+const HEADER: &str = "time_s,phase,true_force_n,fbg1_nm,fbg2_nm,force_n,force_uncompensated_n,over_range,setpoint_n,\
+controller_on,controller_output_deg_s,growth_motor_rad,twine_motor_rad,object_height_m,slip_speed_m_s,grip_force_n";
+
+/// Streams rows to a CSV file; rows already written survive a failed run.
+pub struct TraceWriter {
+    out: std::io::BufWriter<std::fs::File>,
+}
+
+impl TraceWriter {
+    /// Creates (truncates) `path` and writes the header.
+    pub fn create(path: &Path) -> std::io::Result<TraceWriter> {
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        writeln!(out, "{HEADER}")?;
+        Ok(TraceWriter { out })
+    }
+
+    /// Appends one row.
+    pub fn write(&mut self, r: &TraceRow) -> std::io::Result<()> {
+        writeln!(
+            self.out,
+            "{:.4},{},{:.5},{:.4},{:.4},{:.5},{:.5},{},{:.3},{},{:.3},{:.5},{:.5},{:.5},{:.5},{:.4}",
+            r.time_s,
+            r.phase.name(),
+            r.true_force_n,
+            r.fbg1_nm,
+            r.fbg2_nm,
+            r.force_n,
+            r.force_uncompensated_n,
+            u8::from(r.over_range),
+            r.setpoint_n,
+            u8::from(r.controller_on),
+            r.controller_output_deg_s,
+            r.growth_motor_rad,
+            r.twine_motor_rad,
+            r.object_height_m,
+            r.slip_speed_m_s,
+            r.grip_force_n,
+        )
+    }
+
+    /// Flushes everything written so far to disk.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
+}
