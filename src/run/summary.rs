@@ -1,0 +1,122 @@
+//! `summary.json`: the one-record result of a run, also the row of a sweep's `results.csv`.
+
+use super::runner::{Outcome, RunReport};
+use serde::{Deserialize, Serialize};
+
+/// PID gains as reported.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Gains {
+    /// Proportional gain [(°/s)/N].
+    pub kp: f64,
+    /// Integral gain [(°/s)/(N·s)].
+    pub ki: f64,
+    /// Derivative gain [(°/s)/(N/s)].
+    pub kd: f64,
+}
+
+/// The summary of one run. Times are in seconds; `drop_time_s` counts from the moment the arm
+/// started moving the object (the paper's Fig. 9 time axis), `drop_cell_time_s` from activation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// Object name.
+    pub object: String,
+    /// Object mass [kg].
+    pub mass_kg: f64,
+    /// Force control kept on while the arm moves.
+    pub feedback: bool,
+    /// PID gains.
+    pub gains: Gains,
+    /// Force setpoint [N].
+    pub setpoint_n: f64,
+    /// "held", "dropped" or "error".
+    pub outcome: String,
+    /// Time of the drop after the arm started moving [s].
+    pub drop_time_s: Option<f64>,
+    /// Time of the drop since activation [s].
+    pub drop_cell_time_s: Option<f64>,
+    /// Phase of the drop.
+    pub drop_phase: Option<String>,
+    /// When the sensor-based detector saw slip start, after the arm started moving [s].
+    pub slip_detected_s: Option<f64>,
+    /// From force control on to 90 % of the setpoint [s].
+    pub rise_time_90_s: Option<f64>,
+    /// Overshoot during the grasp [% of setpoint].
+    pub overshoot_pct: f64,
+    /// Largest |F − setpoint| / setpoint while the arm moves, held runs only [%].
+    pub max_fluctuation_pct: Option<f64>,
+    /// Smallest force estimate while the arm moved [N].
+    pub min_moving_force_n: Option<f64>,
+    /// RMS error of the estimate against the true force while holding [N].
+    pub force_rmse_n: Option<f64>,
+    /// Simulated (or cell) time covered [s].
+    pub sim_time_s: f64,
+    /// Wall-clock time of the run [s].
+    pub wall_time_s: f64,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// Seed of every random process in the run.
+    pub seed: u64,
+    /// Which cell ran it ("mujoco", "real", ...).
+    pub backend: String,
+    /// The error that ended the run, with its time.
+    pub error: Option<String>,
+}
+
+/// What identifies a run besides its report.
+#[derive(Debug, Clone)]
+pub struct RunIdentity {
+    /// Scenario name.
+    pub scenario: String,
+    /// Object name.
+    pub object: String,
+    /// Object mass [kg].
+    pub mass_kg: f64,
+    /// Feedback while moving.
+    pub feedback: bool,
+    /// Gains.
+    pub gains: Gains,
+    /// Setpoint [N].
+    pub setpoint_n: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Backend name.
+    pub backend: String,
+}
+
+impl RunSummary {
+    /// Builds the summary from a run's identity, report and wall time.
+    pub fn new(id: RunIdentity, report: &RunReport, wall_time_s: f64) -> RunSummary {
+        let since_motion = |t: f64| report.motion_start_s.map(|m| t - m);
+        RunSummary {
+            scenario: id.scenario,
+            object: id.object,
+            mass_kg: id.mass_kg,
+            feedback: id.feedback,
+            gains: id.gains,
+            setpoint_n: id.setpoint_n,
+            outcome: match report.outcome {
+                Outcome::Held => "held",
+                Outcome::Dropped => "dropped",
+                Outcome::Error => "error",
+            }
+            .to_string(),
+            drop_time_s: report.drop.and_then(|d| since_motion(d.cell_time_s)),
+            drop_cell_time_s: report.drop.map(|d| d.cell_time_s),
+            drop_phase: report.drop.map(|d| d.phase.name().to_string()),
+            slip_detected_s: report.slip.slip_start_s.and_then(since_motion),
+            rise_time_90_s: report.metrics.rise_time_90_s,
+            overshoot_pct: report.metrics.overshoot_pct,
+            max_fluctuation_pct: report.metrics.max_fluctuation_pct,
+            min_moving_force_n: report.metrics.min_moving_force_n,
+            force_rmse_n: report.metrics.force_rmse_n,
+            sim_time_s: report.cell_time_s,
+            wall_time_s,
+            real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },
+            seed: id.seed,
+            backend: id.backend,
+            error: report.error.clone(),
+        }
+    }
+}
