@@ -1,0 +1,1 @@
+//! HYPERION (placeholder).

@@ -1,0 +1,1 @@
+//! UR RTDE (placeholder).
