@@ -7,6 +7,7 @@
 use super::HyperionError;
 use super::message::{Request, Response};
 use super::peaks::PeakFrame;
+use crate::cell::real::protocol::Decoded;
 
 /// What the virtual instrument reports.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,6 +110,25 @@ impl VirtualInterrogator {
         Response::ok("", self.peaks.encode()?).encode()
     }
 
+    /// Takes complete requests off the front of `buf` (removing them) and returns the reply bytes.
+    /// An error means the stream is unusable (oversized or non-ASCII request): close the connection.
+    pub fn feed(&mut self, buf: &mut Vec<u8>) -> Result<Vec<u8>, HyperionError> {
+        let mut out = Vec::new();
+        loop {
+            match Request::decode(buf) {
+                Decoded::NeedMore => return Ok(out),
+                Decoded::Frame { packet, consumed } => {
+                    buf.drain(..consumed);
+                    out.extend_from_slice(&self.handle(&packet).encode()?);
+                }
+                Decoded::Invalid { error, consumed } => {
+                    buf.drain(..consumed);
+                    return Err(error);
+                }
+            }
+        }
+    }
+
     /// Answers one command (commands are matched without regard to case).
     pub fn handle(&mut self, request: &Request) -> Response {
         let arg = request.argument.trim();
@@ -191,6 +211,21 @@ mod tests {
         assert_eq!(decoded.channels.len(), 4);
         assert_eq!(decoded.channel(1).unwrap(), &[1540.5, 1550.25]);
         assert!(dev.set_peaks(PeakFrame { channels: vec![vec![]; 5], ..PeakFrame::default() }).is_err());
+    }
+
+    #[test]
+    fn feed_answers_pipelined_requests_in_order() {
+        let mut dev = VirtualInterrogator::new(InterrogatorConfig::default()).unwrap();
+        let mut buf = Request::new("#GetDutChannelCount", "").encode().unwrap();
+        buf.extend_from_slice(&Request::new("#Bogus", "").encode().unwrap());
+        let half = Request::new("#isready", "").encode().unwrap();
+        buf.extend_from_slice(&half[..5]);
+        let out = dev.feed(&mut buf).unwrap();
+        assert_eq!(buf.len(), 5, "the partial request waits for the rest");
+        let Decoded::Frame { packet: first, consumed } = Response::decode(&out) else { panic!("no reply") };
+        assert_eq!(first.content, 4u32.to_le_bytes());
+        let Decoded::Frame { packet: second, .. } = Response::decode(&out[consumed..]) else { panic!("no reply") };
+        assert_ne!(second.status, 0);
     }
 
     #[test]

@@ -13,7 +13,7 @@ pub mod peaks;
 pub use device::{InterrogatorConfig, VirtualInterrogator};
 pub use fbg_map::{FbgMapError, FbgWindows};
 pub use message::{Request, Response};
-pub use peaks::{PeakFrame, PeakHeader, PeakSequence, SequenceCheck};
+pub use peaks::{PeakFrame, PeakHeader, PeakSequence, SequenceCheck, decode_stream_frame};
 
 /// TCP port for commands.
 pub const COMMAND_PORT: u16 = 51971;

@@ -6,6 +6,8 @@
 //! peak wavelengths (nm) of all channels in channel order. Little-endian.
 
 use super::HyperionError;
+use super::message::Response;
+use crate::cell::real::protocol::Decoded;
 
 /// Fixed part of the peak header, in bytes.
 pub const PEAK_HEADER_LEN: usize = 24;
@@ -105,6 +107,19 @@ impl PeakFrame {
     }
 }
 
+/// Takes one streamed peak frame (8-byte response header, then peak content) off the front of
+/// `buf`, as received on the peak stream port.
+pub fn decode_stream_frame(buf: &[u8]) -> Decoded<PeakFrame, HyperionError> {
+    match Response::decode(buf) {
+        Decoded::NeedMore => Decoded::NeedMore,
+        Decoded::Invalid { error, consumed } => Decoded::Invalid { error, consumed },
+        Decoded::Frame { packet, consumed } => match packet.into_result().and_then(|c| PeakFrame::decode(&c)) {
+            Ok(frame) => Decoded::Frame { packet: frame, consumed },
+            Err(error) => Decoded::Invalid { error, consumed },
+        },
+    }
+}
+
 /// What a new serial number says about the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SequenceCheck {
@@ -180,6 +195,16 @@ mod tests {
         negative[24..26].copy_from_slice(&(-1i16).to_le_bytes());
         assert!(PeakFrame::decode(&negative).is_err());
         assert!(PeakFrame::decode(&[0; 10]).is_err());
+    }
+
+    #[test]
+    fn stream_frames_decode_back_to_back() {
+        let one = Response::ok("", frame().encode().unwrap()).encode().unwrap();
+        let mut two = one.clone();
+        two.extend_from_slice(&one[..10]);
+        let Decoded::Frame { packet, consumed } = decode_stream_frame(&two) else { panic!("no frame") };
+        assert_eq!((packet, consumed), (frame(), one.len()));
+        assert_eq!(decode_stream_frame(&two[consumed..]), Decoded::NeedMore);
     }
 
     #[test]
