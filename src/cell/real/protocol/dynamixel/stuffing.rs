@@ -4,6 +4,11 @@
 //! The stuffed region is everything after the instruction byte up to the CRC (parameters of an
 //! instruction packet; error byte and parameters of a status packet), as in the ROBOTIS SDK and
 //! the `dynamixel2` crate. The length field and the CRC cover the stuffed bytes.
+//!
+//! Overlapping runs count: `FF FF FF FD` is stuffed (the pattern starts at the second `FF`).
+//! This matches ROBOTIS DynamixelSDK `addStuffing` byte for byte (checked against the PyPI
+//! `dynamixel-sdk` for every payload of up to 7 bytes over {FF, FD, 00, 01}); `dynamixel2` 0.9.1
+//! misses that overlapping case in both directions.
 
 /// Stuffs `body`: after every `FF FF FD`, an extra `FD`.
 pub fn stuff(body: &[u8]) -> Vec<u8> {

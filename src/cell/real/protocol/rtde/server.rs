@@ -5,6 +5,9 @@
 //! per request); name lists may end with a comma; unknown names get `NOT_FOUND` in the reply
 //! (the recipe is then invalid, ID 0), never a dropped connection.
 //!
+//! Checked by hand (not in CI) with the PyPI `ur_rtde` `RTDEReceiveInterface` over TCP: the
+//! 58-name default recipe at 500 Hz, `actual_q`, robot mode, runtime state and timestamps read back.
+//!
 //! Recipe IDs: output and input recipes are numbered separately from 1, as ur_rtde's control
 //! interface assumes (its input recipes are 1, 2, ... after one output setup).
 
