@@ -1,0 +1,111 @@
+//! Dynamixel Protocol 2.0 (ROBOTIS e-manual) and a virtual MX-106 bus.
+//!
+//! - [`crc`], [`stuffing`], [`packet`]: CRC-16, byte stuffing, framing with resync ([`StreamDecoder`]).
+//! - [`instruction`]: typed instruction and status packets.
+//! - [`control_table`]: the MX-106 (model 321) control table.
+//! - [`device`]: [`VirtualBus`], the device side `tendril serve` runs behind a pseudo-terminal.
+//! - [`units`]: ticks, velocity and current units to SI.
+//!
+//! For the client side on real hardware, the `dynamixel2` crate's `Bus` does the serial IO;
+//! these types are for the virtual device and for tests.
+
+pub mod control_table;
+pub mod crc;
+pub mod device;
+pub mod instruction;
+pub mod packet;
+pub mod stuffing;
+pub mod units;
+
+pub use control_table::ControlTable;
+pub use device::VirtualBus;
+pub use instruction::{BulkReadEntry, BulkWriteEntry, Instruction, InstructionPacket, StatusErrorCode, StatusPacket};
+pub use packet::{BROADCAST_ID, RawPacket, StreamDecoder};
+
+/// Longest packet accepted or produced, in wire bytes. Real devices have smaller receive buffers;
+/// the cap bounds how long a corrupt length field can stall the stream decoder.
+pub const MAX_PACKET_LEN: usize = 4096;
+
+/// Dynamixel protocol errors.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DxlError {
+    /// Bytes before the next header were dropped.
+    #[error("skipped {skipped} bytes that are not a packet header")]
+    Garbage {
+        /// Bytes dropped.
+        skipped: usize,
+    },
+    /// The length field is below 3 or above the cap.
+    #[error("packet length field {len} is invalid")]
+    BadLength {
+        /// The length field.
+        len: usize,
+    },
+    /// The CRC does not match.
+    #[error("CRC mismatch: computed {expected:#06x}, received {received:#06x}")]
+    BadCrc {
+        /// CRC of the received bytes.
+        expected: u16,
+        /// CRC field of the packet.
+        received: u16,
+    },
+    /// A packet to encode is too long.
+    #[error("packet of {len} bytes exceeds the {max}-byte limit")]
+    TooLong {
+        /// Encoded length.
+        len: usize,
+        /// Limit.
+        max: usize,
+    },
+    /// The instruction byte is not in Protocol 2.0.
+    #[error("unknown instruction {0:#04x}")]
+    UnknownInstruction(u8),
+    /// The parameters do not fit the instruction.
+    #[error("{len} parameter bytes do not fit instruction {instruction:#04x}")]
+    BadParameters {
+        /// Instruction byte.
+        instruction: u8,
+        /// Parameter count.
+        len: usize,
+    },
+    /// A status packet where an instruction was expected.
+    #[error("expected an instruction packet, got a status packet")]
+    NotAnInstruction,
+    /// An instruction packet where a status was expected.
+    #[error("expected a status packet, got instruction {0:#04x}")]
+    NotAStatus(u8),
+    /// A status packet without its error byte.
+    #[error("status packet has no error byte")]
+    MissingErrorByte,
+    /// The address range is outside the control table.
+    #[error("address {address} length {length} is outside the control table")]
+    OutOfTable {
+        /// Start address.
+        address: u16,
+        /// Length.
+        length: u16,
+    },
+    /// Address not writable by the host.
+    #[error("address {address} is read-only or unassigned")]
+    NotWritable {
+        /// First offending address.
+        address: u16,
+    },
+    /// EEPROM write while torque is on.
+    #[error("address {address} is in EEPROM, writable only with torque off")]
+    EepromLocked {
+        /// First offending address.
+        address: u16,
+    },
+    /// Invalid or duplicate device ID.
+    #[error("device ID {0} is invalid or already on the bus")]
+    BadDeviceId(u8),
+    /// A physical value has no representation in the field.
+    #[error("{quantity} {value} is not representable in the device's units")]
+    Unrepresentable {
+        /// What was converted.
+        quantity: &'static str,
+        /// The value.
+        value: f64,
+    },
+}

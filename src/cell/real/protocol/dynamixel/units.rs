@@ -1,0 +1,86 @@
+//! MX-106 unit conversions (hardware.md: 4096 ticks/rev (0.088°/tick), 0.229 rpm, 3.36 mA).
+//!
+//! Position ticks map linearly to radians with 0 ticks = 0 rad; where the mechanism's zero is
+//! (e.g. 2048 = mid-range in position mode) is the driver's calibration, not the codec's.
+
+use super::DxlError;
+use std::f64::consts::TAU;
+
+/// Encoder ticks per output-shaft revolution (12-bit encoder).
+pub const TICKS_PER_REV: f64 = 4096.0;
+/// One Goal/Present Velocity unit, in rpm.
+pub const VELOCITY_UNIT_RPM: f64 = 0.229;
+/// One Goal/Present Current unit, in A.
+pub const CURRENT_UNIT_A: f64 = 3.36e-3;
+
+/// Radians per position tick.
+pub const RAD_PER_TICK: f64 = TAU / TICKS_PER_REV;
+/// rad/s per velocity unit.
+pub const RAD_S_PER_VELOCITY_UNIT: f64 = VELOCITY_UNIT_RPM * TAU / 60.0;
+
+/// Position ticks to radians.
+pub fn ticks_to_rad(ticks: i32) -> f64 {
+    f64::from(ticks) * RAD_PER_TICK
+}
+
+/// Radians to the nearest position tick; NaN or beyond the i32 range is an error.
+pub fn rad_to_ticks(rad: f64) -> Result<i32, DxlError> {
+    to_int(rad / RAD_PER_TICK, "position (rad)", rad)
+}
+
+/// Velocity units to rad/s.
+pub fn velocity_units_to_rad_s(units: i32) -> f64 {
+    f64::from(units) * RAD_S_PER_VELOCITY_UNIT
+}
+
+/// rad/s to the nearest velocity unit.
+pub fn rad_s_to_velocity_units(rad_s: f64) -> Result<i32, DxlError> {
+    to_int(rad_s / RAD_S_PER_VELOCITY_UNIT, "velocity (rad/s)", rad_s)
+}
+
+/// Current units to amperes.
+pub fn current_units_to_amps(units: i16) -> f64 {
+    f64::from(units) * CURRENT_UNIT_A
+}
+
+/// Amperes to the nearest current unit (a signed 2-byte field).
+pub fn amps_to_current_units(amps: f64) -> Result<i16, DxlError> {
+    let units = to_int(amps / CURRENT_UNIT_A, "current (A)", amps)?;
+    i16::try_from(units).map_err(|_| DxlError::Unrepresentable { quantity: "current (A)", value: amps })
+}
+
+fn to_int(scaled: f64, quantity: &'static str, value: f64) -> Result<i32, DxlError> {
+    let rounded = scaled.round();
+    if rounded.is_finite() && rounded >= f64::from(i32::MIN) && rounded <= f64::from(i32::MAX) {
+        Ok(rounded as i32)
+    } else {
+        Err(DxlError::Unrepresentable { quantity, value })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_revolution_is_4096_ticks() {
+        assert_eq!(rad_to_ticks(TAU).unwrap(), 4096);
+        assert!((ticks_to_rad(1).to_degrees() - 0.088).abs() < 1e-3);
+        assert_eq!(rad_to_ticks(ticks_to_rad(-1234)).unwrap(), -1234);
+    }
+
+    #[test]
+    fn velocity_and_current_units() {
+        // 45 rpm no-load speed at 12 V is about 197 units.
+        assert_eq!(rad_s_to_velocity_units(45.0 * TAU / 60.0).unwrap(), 197);
+        assert!((current_units_to_amps(1000) - 3.36).abs() < 1e-12);
+        assert_eq!(amps_to_current_units(-3.36).unwrap(), -1000);
+    }
+
+    #[test]
+    fn nan_and_overflow_are_errors() {
+        assert!(rad_to_ticks(f64::NAN).is_err());
+        assert!(rad_to_ticks(1e12).is_err());
+        assert!(amps_to_current_units(200.0).is_err());
+    }
+}
