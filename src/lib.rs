@@ -24,4 +24,5 @@ pub mod cli;
 pub mod control;
 pub mod reproduce;
 pub mod scenario;
+pub mod sensor_bench;
 pub mod signals;
