@@ -16,8 +16,9 @@ use crate::signals::Wavelengths;
 use serde::{Deserialize, Serialize};
 
 /// Readings above this fraction of the range are flagged over-range. The sensor saturates when the
-/// uvula bottoms out; on the loading branch the saturated reading maps through the fitted curve to
-/// about 96 % of the range (hysteresis lowers it), so a reading there cannot be told from saturation.
+/// uvula bottoms out; on the loading branch the saturated reading maps through the paper's curve to
+/// about 4.63 N (hysteresis keeps it below 4.69 N), so a reading above 95 % of the range cannot be
+/// told from saturation.
 pub const OVER_RANGE_FRACTION: f64 = 0.95;
 
 /// Calibration of eq. (8): `Δλ1_strain [pm] = a·N² + b·N + c`, the temperature ratio and the range.

@@ -48,16 +48,17 @@ fn at_most(quantity: &str, paper: &str, twin: f64, limit: f64, unit: &str, digit
 pub fn rows(scenario_dir: &Path) -> anyhow::Result<Vec<Row>> {
     let path = |name: &str| scenario_dir.join(name);
     let (_, cal_rec) = run_scenario(&path(SCENARIOS[0]))?;
-    let (_, val_rec) = run_scenario(&path(SCENARIOS[1]))?;
+    let (val_s, val_rec) = run_scenario(&path(SCENARIOS[1]))?;
     let (_, temp_rec) = run_scenario(&path(SCENARIOS[2]))?;
     let (comp_s, comp_rec) = run_scenario(&path(SCENARIOS[3]))?;
 
     let fit = calibration::force_calibration(&cal_rec).context(SCENARIOS[0])?;
     let temp = calibration::temperature_calibration(&temp_rec).context(SCENARIOS[2])?;
     let cal = fit.calibration(temp.r);
-    let cmp = calibration::compare(&val_rec, &cal).context(SCENARIOS[1])?;
+    let cmp = calibration::compare(&val_rec, val_s.estimator.as_ref().unwrap_or(&cal)).context(SCENARIOS[1])?;
     let taped = comp_s.taped_heating.as_ref().context("bench-compensation.toml needs [taped_heating]")?;
-    let comp = calibration::compensation_test(&comp_rec, &cal, taped.settle_s, 1.0).context(SCENARIOS[3])?;
+    let comp_cal = comp_s.estimator.as_ref().unwrap_or(&cal);
+    let comp = calibration::compensation_test(&comp_rec, comp_cal, taped.settle_s, 1.0).context(SCENARIOS[3])?;
     let model = calibration::fit_hysteresis_model(&cal_rec, &cal).context("hysteresis model")?;
     let cmp_h = calibration::compare(&val_rec, &ForceCalibration { hysteresis: Some(model), ..cal.clone() })
         .context("hysteresis compensation")?;

@@ -23,6 +23,9 @@ pub struct BenchScenario {
     /// How the bench logs samples.
     #[serde(default)]
     pub recorder: RecorderConfig,
+    /// Calibration to read this run with (validation and compensation runs). Absent: the one the
+    /// calibration scenarios fit (`tendril reproduce sensor`).
+    pub estimator: Option<crate::control::estimate::ForceCalibration>,
     /// Load/unload cycles by the linear actuator (force calibration and validation).
     pub force_cycles: Option<ForceCycles>,
     /// Free sensor in a heated water bath (temperature calibration).
@@ -45,6 +48,9 @@ impl Validate for BenchScenario {
         at.section("interrogator", &self.interrogator);
         at.section("load_cell", &self.load_cell);
         at.section("recorder", &self.recorder);
+        if let Some(e) = &self.estimator {
+            at.section("estimator", e);
+        }
         at.require("(top level)", self.experiments() == 1, || {
             format!(
                 "needs exactly one experiment section ([force_cycles], [water_bath] or [taped_heating]), found {}",
