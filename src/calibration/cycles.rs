@@ -1,11 +1,15 @@
 //! Load/unload cycle segmentation of a bench record, from the load-cell force alone.
 //!
 //! The load cell is noisy (≈ 0.1 N on the paper's bench), so the force is first smoothed with a
-//! centred 0.1 s moving average. A cycle is a run of samples whose smoothed force exceeds 5 % of the
+//! centred 0.3 s moving average. A cycle is a run of samples whose smoothed force exceeds 5 % of the
 //! record's maximum; samples before the run's maximum are loading, after it unloading.
 
+/// Bins averaged (centred) when locating the widest gap of a loop: ±0.2 N at 0.1 N bins, which
+/// keeps the location within ±0.1 N on the shipped calibration run (the raw bins are noisy).
+pub const GAP_AVERAGE_BINS: usize = 5;
+
 /// Width of the centred moving average applied to the load-cell force [s].
-pub const SMOOTHING_WINDOW_S: f64 = 0.1;
+pub const SMOOTHING_WINDOW_S: f64 = 0.3;
 /// A sample belongs to a cycle when its smoothed force exceeds this fraction of the maximum [-].
 pub const ACTIVE_FRACTION: f64 = 0.05;
 /// A run above [`ACTIVE_FRACTION`] counts as a cycle only if its peak reaches this fraction of the
@@ -88,7 +92,8 @@ pub fn segment(smoothed: &[f64]) -> (Vec<Cycle>, Vec<Branch>) {
 }
 
 /// Largest gap `mean(unloading) − mean(loading)` of `signal` between the two branches, in bins of
-/// `bin_width` of the (smoothed) force `x`, averaged over 3 neighbouring bins to damp noise.
+/// `bin_width` of the (smoothed) force `x`, averaged over [`GAP_AVERAGE_BINS`] neighbouring bins to
+/// damp noise.
 /// Returns `(gap, force at the gap)`, or `None` when no bin has samples on both branches.
 pub fn max_branch_gap(x: &[f64], signal: &[f64], branches: &[Branch], bin_width: f64) -> Option<(f64, f64)> {
     let max_x = x.iter().copied().fold(0.0, f64::max);
@@ -117,7 +122,9 @@ pub fn max_branch_gap(x: &[f64], signal: &[f64], branches: &[Branch], bin_width:
         .collect();
     let mut best: Option<(f64, f64)> = None;
     for k in 0..bins {
-        let window: Vec<f64> = gaps[k.saturating_sub(1)..(k + 2).min(bins)].iter().flatten().copied().collect();
+        let half = GAP_AVERAGE_BINS / 2;
+        let window: Vec<f64> =
+            gaps[k.saturating_sub(half)..(k + half + 1).min(bins)].iter().flatten().copied().collect();
         if gaps[k].is_none() || window.is_empty() {
             continue;
         }
@@ -176,7 +183,7 @@ mod tests {
             b.push(Branch::Unloading);
         }
         let (gap, at) = max_branch_gap(&x, &y, &b, 0.1).unwrap();
-        assert!((gap - 0.2).abs() < 0.002, "{gap}");
+        assert!((gap - 0.2).abs() < 0.005, "{gap}"); // the 5-bin average flattens the crest slightly
         assert!((at - 1.5).abs() < 0.11, "{at}");
     }
 }

@@ -60,13 +60,15 @@ pub struct CompensationResult {
     pub uncompensated_rmse_n: f64,
     /// Largest uncompensated error after settling [N].
     pub max_uncompensated_error_n: f64,
-    /// Temperature change seen by FBG2 over the test, `Δλ2/K_T2` [°C] with `K_T2` from `r`·... see docs.
+    /// FBG2 shift over the last `window_s` of the test from the tare [pm]; divided by `K_T2` it is
+    /// the temperature change the paper reads from the strain-free grating (11 °C).
     pub fbg2_shift_pm: f64,
 }
 
 /// The compensation test: the sensor holds a constant force while the water heats. The paper has no
 /// reference force here, so the errors are measured about the sensor's own settled reading: the mean
 /// compensated estimate over `[settle_s, settle_s + window_s]`. RMSEs cover `t ≥ settle_s`.
+/// The FBG2 shift is averaged over the last `window_s`.
 pub fn compensation_test(
     record: &BenchRecord,
     cal: &ForceCalibration,
@@ -96,12 +98,14 @@ pub fn compensation_test(
     let rms =
         |v: &[f64]| (after.iter().map(|&i| (v[i] - reference_n).powi(2)).sum::<f64>() / after.len() as f64).sqrt();
     let max_err = after.iter().map(|&i| (uncompensated[i] - reference_n).abs()).fold(0.0, f64::max);
-    let last = record.rows.last().ok_or(CalibrationError::Empty)?;
+    let end = record.rows.last().ok_or(CalibrationError::Empty)?.time_s;
+    let tail: Vec<f64> = record.rows.iter().filter(|r| r.time_s >= end - window_s).map(|r| r.fbg2_nm).collect();
+    let fbg2_end_nm = tail.iter().sum::<f64>() / tail.len() as f64;
     Ok(CompensationResult {
         reference_n,
         compensated_rmse_n: rms(&compensated),
         uncompensated_rmse_n: rms(&uncompensated),
         max_uncompensated_error_n: max_err,
-        fbg2_shift_pm: (last.fbg2_nm - tare.fbg2_nm) * 1000.0,
+        fbg2_shift_pm: (fbg2_end_nm - tare.fbg2_nm) * 1000.0,
     })
 }

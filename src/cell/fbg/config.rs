@@ -53,12 +53,12 @@ pub struct SensorConfig {
 impl Default for SensorConfig {
     fn default() -> Self {
         SensorConfig {
-            strain_k1_pm_per_n: 282.58,
-            strain_k2_pm_per_n2: 302.75,
-            strain_k3_pm_per_n3: -21.671,
+            strain_k1_pm_per_n: 310.03,
+            strain_k2_pm_per_n2: 284.20,
+            strain_k3_pm_per_n3: -18.514,
             range_n: 4.69,
             hysteresis_widths_n: vec![0.6, 1.3, 2.0],
-            hysteresis_weights: vec![0.033, 0.033, 0.055],
+            hysteresis_weights: vec![0.0345, 0.0345, 0.0575],
             kt1_pm_per_c: 24.29,
             kt2_pm_per_c: 10.31,
             thermal_lag1_s: 10.0,
@@ -205,7 +205,7 @@ impl Default for SpectralConfig {
             end_nm: 1554.0,
             step_pm: 10.0,
             channel_split_nm: 1547.8,
-            intensity_noise: 0.01,
+            intensity_noise: 0.015,
             threshold: 0.5,
         }
     }
