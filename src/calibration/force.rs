@@ -235,3 +235,56 @@ pub fn fit_hysteresis_model(record: &BenchRecord, cal: &ForceCalibration) -> Res
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibration::BenchRow;
+
+    /// Three triangle cycles to 4 N on a known quadratic, with an optional loop on unloading.
+    fn record(loop_pm: f64) -> BenchRecord {
+        let rows = (0..=3100)
+            .map(|i| {
+                let t = i as f64 * 0.01;
+                let phase = ((t - 1.0) / 10.0).rem_euclid(1.0);
+                let active = t >= 1.0;
+                let f = if !active {
+                    0.0
+                } else if phase < 0.5 {
+                    8.0 * phase
+                } else {
+                    8.0 * (1.0 - phase)
+                };
+                let extra = if active && phase >= 0.5 { loop_pm * (std::f64::consts::PI * f / 4.0).sin() } else { 0.0 };
+                let d = 100.0 * f * f + 500.0 * f + extra;
+                BenchRow {
+                    time_s: t,
+                    load_cell_n: Some(f),
+                    fbg1_nm: 1540.0 + d / 1e3,
+                    fbg2_nm: 1550.0,
+                    temperature_c: None,
+                }
+            })
+            .collect();
+        BenchRecord { rows }
+    }
+
+    #[test]
+    fn recovers_a_known_curve_without_hysteresis() {
+        let f = force_calibration(&record(0.0)).unwrap();
+        assert_eq!(f.cycles, 3);
+        assert!((f.a_pm_per_n2 - 100.0).abs() < 1e-6 && (f.b_pm_per_n - 500.0).abs() < 1e-6 && f.c_pm.abs() < 1e-6);
+        assert!(f.rmse_pm < 1e-6 && f.rmse_n < 1e-6);
+        assert!((f.sensitivity_pm_per_n - 900.0).abs() < 15.0, "{}", f.sensitivity_pm_per_n);
+        // Not exactly 0: the branches sample each bin at different forces.
+        assert!(f.hysteresis_percent.abs() < 0.1, "{} at {}", f.hysteresis_percent, f.hysteresis_at_n);
+    }
+
+    #[test]
+    fn finds_a_known_loop() {
+        let f = force_calibration(&record(180.0)).unwrap();
+        // 180 pm of 3600 pm full scale = 5 %, widest at 2 N.
+        assert!((f.hysteresis_percent - 5.0).abs() < 0.3, "{}", f.hysteresis_percent);
+        assert!((f.hysteresis_at_n - 2.0).abs() < 0.2, "{}", f.hysteresis_at_n);
+    }
+}

@@ -109,3 +109,53 @@ pub fn compensation_test(
         fbg2_shift_pm: (fbg2_end_nm - tare.fbg2_nm) * 1000.0,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibration::BenchRow;
+
+    fn row(t: f64, d1_pm: f64, d2_pm: f64, temp: Option<f64>) -> BenchRow {
+        BenchRow {
+            time_s: t,
+            load_cell_n: None,
+            fbg1_nm: 1540.0 + d1_pm / 1e3,
+            fbg2_nm: 1550.0 + d2_pm / 1e3,
+            temperature_c: temp,
+        }
+    }
+
+    #[test]
+    fn recovers_known_sensitivities() {
+        let rows = (0..200)
+            .map(|i| {
+                let temp = 25.0 + i as f64 * 0.1;
+                row(i as f64, 20.0 * (temp - 25.0) + 7.0, 8.0 * (temp - 25.0), Some(temp))
+            })
+            .collect();
+        let f = temperature_calibration(&BenchRecord { rows }).unwrap();
+        assert!((f.kt1_pm_per_c - 20.0).abs() < 1e-6 && (f.kt2_pm_per_c - 8.0).abs() < 1e-6);
+        assert!((f.r - 2.5).abs() < 1e-6 && f.r2_1 > 0.999_999);
+        let no_temp = BenchRecord { rows: (0..20).map(|i| row(i as f64, 0.0, 0.0, None)).collect() };
+        assert!(matches!(temperature_calibration(&no_temp), Err(CalibrationError::NoTemperature)));
+    }
+
+    #[test]
+    fn compensation_test_separates_drift_from_force() {
+        // Constant 1 N on the paper's curve; 10 °C of heating after 5 s; perfect r.
+        let cal = ForceCalibration::default();
+        let strain = 144.99 + 527.62 - 91.42;
+        let rows = (0..1000)
+            .map(|i| {
+                let t = i as f64 * 0.01;
+                let dt = if t < 5.0 { 0.0 } else { (t - 5.0) * 2.0 };
+                let force = if t < 1.0 { 0.0 } else { strain };
+                row(t, force + 24.29 * dt, 10.31 * dt, None)
+            })
+            .collect();
+        let c = compensation_test(&BenchRecord { rows }, &cal, 2.0, 1.0).unwrap();
+        assert!((c.reference_n - 1.0).abs() < 1e-6, "{}", c.reference_n);
+        assert!(c.compensated_rmse_n < 1e-6);
+        assert!(c.uncompensated_rmse_n > 0.1 && c.max_uncompensated_error_n > 0.2);
+    }
+}

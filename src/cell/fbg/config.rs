@@ -11,8 +11,10 @@ use serde::{Deserialize, Serialize};
 /// that the paper's least-squares quadratic fit, applied to the simulated 4-cycle calibration run
 /// (`scenarios/bench-force-calibration.toml`), returns the paper's `144.99 N² + 527.62 N − 91.42`.
 /// A slightly negative cubic term (the curve straightens near the top as the uvula approaches the
-/// floor) is what gives a quadratic fit its negative intercept although the curve starts at zero;
-/// the same curve ends at ≈ 5480 pm at 4.69 N, the paper's 0 → 5482.78 pm span.
+/// floor) is what gives a quadratic fit its negative intercept although the curve starts at zero.
+/// With the hysteresis below, the loading branch then ends at ≈ 5480 pm at 4.69 N: the paper's
+/// 0 → 5482.78 pm span. Re-solve with `sensor_bench::solve_strain_coefficients` after changing the
+/// hysteresis or the calibration bench (a unit test checks these values are its solution).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorConfig {

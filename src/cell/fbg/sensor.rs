@@ -133,6 +133,40 @@ mod tests {
         assert!((d2 - (1.0 - (-1.0_f64).exp())).abs() < 0.01, "FBG2 fraction {d2}");
     }
 
+    /// The loop of a noise-free 0 → 4.69 → 0 N cycle, straight from the model: widest gap between
+    /// the unloading and the loading branch near the paper's 4.83 % of full scale at 2.68 N.
+    #[test]
+    fn hysteresis_loop_maximum_and_location() {
+        let mut s = FbgSensor::new(&SensorConfig::default(), &quiet(), 1);
+        let steps = 4690;
+        let mut shift = |n: f64| (s.sample(n, 25.0, 0.001).fbg1_nm - 1540.0) * 1000.0;
+        let load: Vec<f64> = (0..=steps).map(|i| shift(i as f64 * 0.001)).collect();
+        let unload: Vec<f64> = (0..=steps).rev().map(|i| shift(i as f64 * 0.001)).collect();
+        let full_scale = load[steps];
+        let (at, gap) = (0..=steps)
+            .map(|i| (i as f64 * 0.001, unload[steps - i] - load[i]))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap();
+        let percent = 100.0 * gap / full_scale;
+        assert!((percent - 4.83).abs() < 0.5, "max hysteresis {percent} %");
+        assert!((at - 2.68).abs() < 0.1, "at {at} N");
+        assert!(unload[steps].abs() < 1e-9, "the loop closes at 0 N");
+    }
+
+    #[test]
+    fn spectral_mode_tracks_the_analytic_peaks() {
+        let spectral = InterrogatorConfig { mode: InterrogatorMode::Spectral, ..InterrogatorConfig::default() };
+        let mut a = FbgSensor::new(&SensorConfig::default(), &quiet(), 1);
+        let mut b = FbgSensor::new(&SensorConfig::default(), &spectral, 1);
+        let mut worst: f64 = 0.0;
+        for i in 0..=200 {
+            let (n, t) = (i as f64 * 0.0234, 20.0 + i as f64 * 0.1);
+            let (wa, wb) = (a.sample(n, t, 0.001), b.sample(n, t, 0.001));
+            worst = worst.max((wa.fbg1_nm - wb.fbg1_nm).abs()).max((wa.fbg2_nm - wb.fbg2_nm).abs());
+        }
+        assert!(worst * 1000.0 < 15.0, "spectral peaks {} pm off", worst * 1000.0);
+    }
+
     #[test]
     fn same_seed_same_samples() {
         let run = |seed| {
