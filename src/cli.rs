@@ -20,6 +20,26 @@ enum Command {
         /// Also write the comparison table as JSON to this file.
         #[arg(long)]
         json: Option<std::path::PathBuf>,
+        /// Folder holding the scenario files.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: std::path::PathBuf,
+    },
+    /// Run the paper's calibration procedures on a bench CSV (columns: time_s, load_cell_n,
+    /// fbg1_nm, fbg2_nm, temperature_c) and print the results.
+    Calibrate {
+        /// The bench CSV.
+        file: std::path::PathBuf,
+    },
+    /// Simulate one bench scenario (scenarios/bench-*.toml) and write its record as CSV.
+    Bench {
+        /// The bench scenario file.
+        scenario: std::path::PathBuf,
+        /// Write the record here (CSV, the format `calibrate` reads); default: standard output.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+        /// Override a scenario value: `--set key.path=value` (repeatable).
+        #[arg(long = "set")]
+        set: Vec<String>,
     },
 }
 
@@ -37,9 +57,45 @@ pub fn main() -> ExitCode {
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        Command::Reproduce { what, json } => {
-            let _ = json;
-            anyhow::bail!("reproduce {what}: not built yet")
+        Command::Reproduce { what, json, scenarios } => {
+            let rows = reproduce_rows(&what, &scenarios)?;
+            print!("{}", crate::reproduce::render_table(&rows));
+            if let Some(path) = json {
+                let text = serde_json::to_string_pretty(&rows)?;
+                std::fs::write(&path, text + "\n")
+                    .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+            }
+            Ok(if rows.iter().all(|r| r.pass) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
         }
+        Command::Calibrate { file } => {
+            print!("{}", crate::calibration::report::calibrate_file(&file)?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Bench { scenario, out, set } => {
+            let overrides = set.iter().map(|s| s.parse()).collect::<Result<Vec<crate::scenario::Override>, _>>()?;
+            let s: crate::sensor_bench::BenchScenario = crate::scenario::load(&scenario, &overrides)?;
+            let csv = crate::sensor_bench::run(&s).to_csv();
+            match out {
+                Some(path) => {
+                    std::fs::write(&path, csv).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?
+                }
+                None => print!("{csv}"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+/// The rows of `tendril reproduce WHAT`: `sensor` (Sec. IV); `all` collects every family
+/// (gripper rows join here when they exist).
+pub fn reproduce_rows(what: &str, scenario_dir: &std::path::Path) -> anyhow::Result<Vec<crate::reproduce::Row>> {
+    match what {
+        "sensor" => crate::reproduce::sensor::rows(scenario_dir),
+        "all" => {
+            let mut rows = Vec::new();
+            rows.extend(crate::reproduce::sensor::rows(scenario_dir)?);
+            Ok(rows)
+        }
+        other => anyhow::bail!("reproduce {other}: unknown (expected sensor or all)"),
     }
 }

@@ -25,4 +25,5 @@ pub mod control;
 pub mod hardware;
 pub mod reproduce;
 pub mod scenario;
+pub mod sensor_bench;
 pub mod signals;

@@ -1,2 +1,3 @@
 //! The cell: where contact forces and wavelengths come from (simulation now, real drivers later).
+pub mod fbg;
 pub mod real;

@@ -1,13 +1,17 @@
 //! Control code shared by the simulated and the real cell: it talks to the cell only through
 //! [`crate::hardware::Cell`].
 //!
+//! - [`estimate`]: the force estimate of eq. (8) with temperature compensation.
+//! - [`hysteresis`]: Prandtl-Ishlinskii operators (forward model and its inverse).
 //! - [`gripper`]: motor angles to finger growth and tendon pull.
 //! - [`task`]: the pick-and-place sequence.
 //! - [`pid`]: the force controller (output: twine motor speed).
 //! - [`trajectory`]: joint-space moves within the paper's speed and acceleration limits.
 //! - [`slip`]: slip and loss detection from the force estimate.
 
+pub mod estimate;
 pub mod gripper;
+pub mod hysteresis;
 pub mod pid;
 pub mod slip;
 pub mod task;

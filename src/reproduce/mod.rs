@@ -83,3 +83,4 @@ mod tests {
         assert!(table.contains("FAIL"));
     }
 }
+pub mod sensor;
