@@ -24,6 +24,8 @@ pub mod cli;
 pub mod control;
 pub mod hardware;
 pub mod reproduce;
+pub mod run;
 pub mod scenario;
 pub mod sensor_bench;
 pub mod signals;
+pub mod sweep;

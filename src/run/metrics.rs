@@ -23,18 +23,14 @@ pub struct ControlMetrics {
 /// after a drop do not count as fluctuation.
 pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMetrics {
     let grasp: Vec<&TraceRow> = rows.iter().filter(|r| r.phase == Phase::Grasp).collect();
-    let rise_time_90_s = grasp.first().and_then(|start| {
-        grasp.iter().find(|r| r.force_n >= 0.9 * r.setpoint_n).map(|r| r.time_s - start.time_s)
-    });
-    let overshoot_pct =
-        grasp.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n) / r.setpoint_n).fold(0.0, f64::max);
-    let moving: Vec<&TraceRow> = rows
-        .iter()
-        .filter(|r| r.phase.arm_moving() && drop_time_s.is_none_or(|d| r.time_s < d))
-        .collect();
-    let max_fluctuation_pct = (drop_time_s.is_none() && !moving.is_empty()).then(|| {
-        moving.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n).abs() / r.setpoint_n).fold(0.0, f64::max)
-    });
+    let rise_time_90_s = grasp
+        .first()
+        .and_then(|start| grasp.iter().find(|r| r.force_n >= 0.9 * r.setpoint_n).map(|r| r.time_s - start.time_s));
+    let overshoot_pct = grasp.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n) / r.setpoint_n).fold(0.0, f64::max);
+    let moving: Vec<&TraceRow> =
+        rows.iter().filter(|r| r.phase.arm_moving() && drop_time_s.is_none_or(|d| r.time_s < d)).collect();
+    let max_fluctuation_pct = (drop_time_s.is_none() && !moving.is_empty())
+        .then(|| moving.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n).abs() / r.setpoint_n).fold(0.0, f64::max));
     let min_moving_force_n = moving.iter().map(|r| r.force_n).reduce(f64::min);
     let compared: Vec<f64> = rows
         .iter()

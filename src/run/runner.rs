@@ -5,10 +5,10 @@
 use super::metrics::{ControlMetrics, control_metrics};
 use super::trace::{TraceRow, TraceWriter};
 use crate::control::estimate::{ForceCalibration, ForceEstimator};
+use crate::control::gripper::GripperConfig;
 use crate::control::pid::{Pid, PidConfig};
 use crate::control::slip::{SlipConfig, SlipDetector, SlipEvents};
 use crate::control::task::{Phase, TaskConfig, TaskSequencer};
-use crate::control::gripper::GripperConfig;
 use crate::hardware::{Cell, CellError};
 use crate::signals::Wavelengths;
 use serde::Serialize;
@@ -85,13 +85,8 @@ const LOST_CONTACT_S: f64 = 0.3;
 /// [`Outcome::Error`]; the rows up to the error are kept.
 pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut TraceWriter>) -> RunReport {
     let mut rows = Vec::new();
-    let mut sequencer = TaskSequencer::new(
-        plan.task.clone(),
-        plan.gripper,
-        Pid::new(plan.pid),
-        plan.setpoint_n,
-        plan.feedback,
-    );
+    let mut sequencer =
+        TaskSequencer::new(plan.task.clone(), plan.gripper, Pid::new(plan.pid), plan.setpoint_n, plan.feedback);
     let mut slip = SlipDetector::new(plan.slip);
     let mut truth_drop: Option<Drop> = None;
     let mut no_contact_since: Option<f64> = None;
@@ -100,7 +95,7 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
     let mut run = || -> Result<(), CellError> {
         cell.configure()?;
         cell.activate()?;
-        let mut estimator = ForceEstimator::new(plan.calibration);
+        let mut estimator = ForceEstimator::new(plan.calibration.clone());
         let mut tare = TareAverager::default();
         for tick in 0u64.. {
             let state = cell.read()?;
@@ -109,7 +104,7 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
                 tare.add(state.wavelengths);
                 estimator.tare(tare.mean());
             }
-            let estimate = estimator.estimate(state.wavelengths).map_err(|e| CellError::Device {
+            let estimate = estimator.track(state.wavelengths).map_err(|e| CellError::Device {
                 device: "estimator".into(),
                 cause: format!("at t = {:.3} s: {e}", state.time_s),
             })?;

@@ -59,8 +59,9 @@ fn invalid(file: &Path, key: &str, reason: impl Into<String>) -> ScenarioError {
 /// [`super::check_runs`].
 pub fn load_sweep(file: &Path) -> Result<Sweep, ScenarioError> {
     let text = std::fs::read_to_string(file).map_err(|source| ScenarioError::Io { file: file.into(), source })?;
-    let table: toml::Table =
-        text.parse().map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.into(), message: e.to_string() })?;
+    let table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.into(), message: e.to_string() })?;
     let spec: SweepFile = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let key = e.path().to_string();
         invalid(file, &key, e.into_inner().to_string())
