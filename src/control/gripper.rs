@@ -18,13 +18,14 @@ pub struct GripperConfig {
     /// Radius of the twine tendon spool [m]. 5 mm: with the finger's stiffness this sets the
     /// force gain dF/dθ that the paper's PID gains act on (see `control::pid`).
     pub twine_spool_radius_m: f64,
-    /// Twine motor travel limit [°] from the straight finger. Past it the tendon is fully wound.
+    /// Twine motor travel limit [°] from the straight finger: 680° winds 59 mm on the 5 mm spool,
+    /// just inside the finger's tendon travel (`finger.twine_max_m`, 60 mm).
     pub twine_max_deg: f64,
 }
 
 impl Default for GripperConfig {
     fn default() -> Self {
-        GripperConfig { growth_pinion_radius_m: 0.012, twine_spool_radius_m: 0.005, twine_max_deg: 720.0 }
+        GripperConfig { growth_pinion_radius_m: 0.012, twine_spool_radius_m: 0.005, twine_max_deg: 680.0 }
     }
 }
 

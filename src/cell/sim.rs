@@ -1,0 +1,192 @@
+//! The simulated cell: the MuJoCo scene and the FBG forward model behind [`Cell`].
+//!
+//! Per tick the control code reads motor angles and the latest interrogator sample and writes
+//! motor targets, exactly as on the real cell. In between, [`Cell::wait_until`] steps the physics
+//! and samples the sensor model at the interrogator's rate with the pad's true contact force.
+
+use super::fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
+use super::physics::{PhysicsError, Scene, SceneModel};
+use crate::control::gripper::GripperConfig;
+use crate::hardware::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
+use crate::scenario::{Checker, Validate};
+use crate::signals::Wavelengths;
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// The sensor's surroundings (TOML `[environment]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EnvironmentConfig {
+    /// Temperature at the sensor when the run starts [°C]: a lab at 25 °C (the paper's room
+    /// temperature, Sec. IV-B).
+    pub temperature_c: f64,
+    /// Temperature drift during the run [°C/s]; 0 in a lab, non-zero to test compensation.
+    pub temperature_ramp_c_per_s: f64,
+}
+
+impl Default for EnvironmentConfig {
+    fn default() -> Self {
+        EnvironmentConfig { temperature_c: 25.0, temperature_ramp_c_per_s: 0.0 }
+    }
+}
+
+impl Validate for EnvironmentConfig {
+    fn validate(&self, at: &mut Checker) {
+        // The TPU casing is printed at 235 °C and softens far below; the paper tests 25-45 °C.
+        at.in_range("temperature_c", self.temperature_c, -20.0, 80.0);
+        at.in_range("temperature_ramp_c_per_s", self.temperature_ramp_c_per_s, -1.0, 1.0);
+    }
+}
+
+impl EnvironmentConfig {
+    /// Temperature at cell time `t` [°C].
+    pub fn temperature_at(&self, t: f64) -> f64 {
+        self.temperature_c + self.temperature_ramp_c_per_s * t
+    }
+}
+
+/// Twin of the gripping cell: MuJoCo physics + FBG forward model.
+pub struct SimCell {
+    model: Arc<SceneModel>,
+    scene: Option<Scene>,
+    sensor_config: SensorConfig,
+    interrogator: InterrogatorConfig,
+    sensor: FbgSensor,
+    gripper: GripperConfig,
+    environment: EnvironmentConfig,
+    seed: u64,
+    lifecycle: Lifecycle,
+    latest: Wavelengths,
+    next_sample_s: f64,
+}
+
+impl SimCell {
+    /// A cell over a compiled scene model (shareable between runs). Nothing is simulated until
+    /// [`Cell::configure`].
+    pub fn new(
+        model: Arc<SceneModel>,
+        sensor: SensorConfig,
+        interrogator: InterrogatorConfig,
+        gripper: GripperConfig,
+        environment: EnvironmentConfig,
+        seed: u64,
+    ) -> SimCell {
+        SimCell {
+            sensor: FbgSensor::new(&sensor, &interrogator, seed),
+            model,
+            scene: None,
+            sensor_config: sensor,
+            interrogator,
+            gripper,
+            environment,
+            seed,
+            lifecycle: Lifecycle::Unconfigured,
+            latest: Wavelengths { fbg1_nm: 0.0, fbg2_nm: 0.0 },
+            next_sample_s: 0.0,
+        }
+    }
+
+    fn scene(&self) -> &Scene {
+        self.scene.as_ref().expect("configured before use: the lifecycle checks guarantee it")
+    }
+
+    fn physics_error(e: PhysicsError) -> CellError {
+        match e {
+            PhysicsError::Diverged { time_s, cause } => CellError::Physics { time_s, cause: cause.to_string() },
+            other => CellError::Physics { time_s: f64::NAN, cause: other.to_string() },
+        }
+    }
+
+    /// Samples the sensor at every interrogator instant up to the scene's time, holding the
+    /// contact force of the last physics step (zero-order hold over one step).
+    fn sample_sensor(&mut self) {
+        let dt = 1.0 / self.interrogator.sample_rate_hz;
+        let now = self.scene().time();
+        let force = self.scene().readout().pad_force_n;
+        while self.next_sample_s <= now + 1e-12 {
+            let temperature = self.environment.temperature_at(self.next_sample_s);
+            self.latest = self.sensor.sample(force, temperature, dt);
+            self.next_sample_s += dt;
+        }
+    }
+}
+
+impl Cell for SimCell {
+    fn backend(&self) -> &str {
+        "mujoco"
+    }
+
+    fn lifecycle(&self) -> Lifecycle {
+        self.lifecycle
+    }
+
+    fn configure(&mut self) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Unconfigured, "configure")?;
+        self.scene = Some(Scene::new(self.model.clone()));
+        self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
+        self.next_sample_s = 0.0;
+        self.lifecycle = Lifecycle::Inactive;
+        Ok(())
+    }
+
+    fn activate(&mut self) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Inactive, "activate")?;
+        self.lifecycle = Lifecycle::Active;
+        self.sample_sensor();
+        Ok(())
+    }
+
+    fn deactivate(&mut self) -> Result<(), CellError> {
+        // Idempotent: the runner calls it on every exit path.
+        if self.lifecycle == Lifecycle::Active {
+            self.lifecycle = Lifecycle::Inactive;
+        }
+        Ok(())
+    }
+
+    fn read(&mut self) -> Result<CellState, CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "read")?;
+        let r = self.scene().readout();
+        Ok(CellState {
+            time_s: r.time_s,
+            arm_q: r.arm_q,
+            growth_motor_rad: self.gripper.growth_motor_rad(r.growth_m),
+            twine_motor_rad: r.twine_m / self.gripper.twine_spool_radius_m,
+            wavelengths: self.latest,
+        })
+    }
+
+    fn write(&mut self, c: &CellCommand) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "write")?;
+        let growth = self.gripper.growth_length_m(c.growth_motor_rad);
+        let twine = self.gripper.tendon_pull_m(c.twine_motor_rad);
+        let scene = self.scene.as_mut().expect("active implies configured");
+        scene.set_arm_target(c.arm_q).map_err(Self::physics_error)?;
+        scene.set_growth(growth).map_err(Self::physics_error)?;
+        scene.set_twine(twine).map_err(Self::physics_error)?;
+        Ok(())
+    }
+
+    fn wait_until(&mut self, time_s: f64) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "wait")?;
+        let scene = self.scene.as_mut().expect("active implies configured");
+        let half_step = 0.5 * scene.timestep();
+        while scene.time() < time_s - half_step {
+            scene.step().map_err(Self::physics_error)?;
+        }
+        self.sample_sensor();
+        Ok(())
+    }
+
+    fn ground_truth(&self) -> Option<GroundTruth> {
+        let scene = self.scene.as_ref()?;
+        let r = scene.readout();
+        Some(GroundTruth {
+            sensor_force_n: r.pad_force_n,
+            grip_force_n: r.grip_force_n,
+            object_height_m: r.object_pos_m[2] - self.model.placement().table_z,
+            slip_speed_m_s: r.slip_speed_m_s,
+            in_contact: r.touching,
+        })
+    }
+}

@@ -1,0 +1,145 @@
+//! The pick-and-place scenario: every section a run on the twin needs, in one TOML file.
+//!
+//! ```toml
+//! name = "hammer"
+//! setpoint_n = 1.6
+//! [object]
+//! name = "hammer"
+//! ```
+//! Everything else has the paper's or the model's documented defaults; see `scenarios/*.toml`.
+
+use super::runner::ControlPlan;
+use crate::cell::fbg::{InterrogatorConfig, SensorConfig};
+use crate::cell::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneSpec};
+use crate::cell::sim::EnvironmentConfig;
+use crate::control::estimate::ForceCalibration;
+use crate::control::gripper::GripperConfig;
+use crate::control::pid::PidConfig;
+use crate::control::slip::SlipConfig;
+use crate::control::task::TaskConfig;
+use crate::scenario::{Checker, Validate};
+use serde::Deserialize;
+
+/// A pick-and-place scenario (`scenarios/crimper.toml`, ...).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PickPlaceScenario {
+    /// Scenario name, echoed in summaries.
+    pub name: String,
+    /// Seed of every random process (sensor noise) [-]; the same seed gives the same trace.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Contact-force setpoint [N] (paper Sec. V-B: crimper 0.6, hammer 1.6, shampoo 0.8).
+    pub setpoint_n: f64,
+    /// Keep force control on while the arm moves (paper: both modes compared).
+    #[serde(default = "default_feedback")]
+    pub feedback: bool,
+    /// Control loop rate [Hz]. 100 Hz: ten interrogator samples per tick, and ample for a loop
+    /// whose closed-loop time constant is about 2 s (paper: 90 % within 5 s).
+    #[serde(default = "default_rate")]
+    pub control_rate_hz: f64,
+    /// The object.
+    pub object: ObjectConfig,
+    /// PID gains and limits.
+    #[serde(default)]
+    pub controller: PidConfig,
+    /// Task poses and timing.
+    #[serde(default)]
+    pub task: TaskConfig,
+    /// Gripper drive train.
+    #[serde(default)]
+    pub gripper: GripperConfig,
+    /// Slip detector.
+    #[serde(default)]
+    pub slip: SlipConfig,
+    /// Calibration used by the estimator (eq. 8).
+    #[serde(default)]
+    pub estimator: ForceCalibration,
+    /// The FBG sensor's physics.
+    #[serde(default)]
+    pub sensor: SensorConfig,
+    /// The interrogator.
+    #[serde(default)]
+    pub interrogator: InterrogatorConfig,
+    /// Temperature at the sensor.
+    #[serde(default)]
+    pub environment: EnvironmentConfig,
+    /// MuJoCo settings.
+    #[serde(default)]
+    pub physics: PhysicsConfig,
+    /// The finger's physical parameters.
+    #[serde(default)]
+    pub finger: FingerConfig,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+fn default_feedback() -> bool {
+    true
+}
+fn default_rate() -> f64 {
+    100.0
+}
+
+impl Validate for PickPlaceScenario {
+    fn validate(&self, at: &mut Checker) {
+        at.require("name", !self.name.trim().is_empty(), || "must not be empty".into());
+        // Above the sensor's range the reading saturates (4.69 N, paper Sec. IV-B).
+        at.require("setpoint_n", self.setpoint_n > 0.0 && self.setpoint_n < self.estimator.range_n, || {
+            format!("must be > 0 and below the sensor's range {} N, got {}", self.estimator.range_n, self.setpoint_n)
+        });
+        at.in_range("control_rate_hz", self.control_rate_hz, 1.0, 1000.0);
+        at.require("control_rate_hz", self.control_rate_hz <= self.interrogator.sample_rate_hz, || {
+            format!("must not exceed interrogator.sample_rate_hz ({})", self.interrogator.sample_rate_hz)
+        });
+        at.section("object", &self.object);
+        at.section("controller", &self.controller);
+        at.section("task", &self.task);
+        at.section("gripper", &self.gripper);
+        at.section("slip", &self.slip);
+        at.section("estimator", &self.estimator);
+        at.section("sensor", &self.sensor);
+        at.section("interrogator", &self.interrogator);
+        at.section("environment", &self.environment);
+        at.section("physics", &self.physics);
+        at.section("finger", &self.finger);
+        let tendon_max_m = self.gripper.tendon_pull_m(self.gripper.twine_max_deg.to_radians());
+        at.require("gripper.twine_max_deg", tendon_max_m <= self.finger.twine_max_m + 1e-9, || {
+            format!(
+                "winds {:.1} mm of tendon, more than finger.twine_max_m ({:.1} mm)",
+                tendon_max_m * 1e3,
+                self.finger.twine_max_m * 1e3
+            )
+        });
+        at.require("task.growth_m", self.task.growth_m <= self.finger.length_m, || {
+            format!("must not exceed finger.length_m ({} m)", self.finger.length_m)
+        });
+    }
+}
+
+impl PickPlaceScenario {
+    /// The physics scene this scenario needs (arm starting at the task's home pose).
+    pub fn scene_spec(&self) -> SceneSpec {
+        SceneSpec {
+            physics: self.physics.clone(),
+            finger: self.finger.clone(),
+            object: Some(self.object.clone()),
+            arm_q0: self.task.home_deg.map(f64::to_radians),
+        }
+    }
+
+    /// What the control side needs.
+    pub fn control_plan(&self) -> ControlPlan {
+        ControlPlan {
+            setpoint_n: self.setpoint_n,
+            feedback: self.feedback,
+            rate_hz: self.control_rate_hz,
+            pid: self.controller,
+            calibration: self.estimator.clone(),
+            task: self.task.clone(),
+            gripper: self.gripper,
+            slip: self.slip,
+        }
+    }
+}
