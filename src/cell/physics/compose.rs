@@ -1,0 +1,218 @@
+//! Assembles a scene's MJCF from the parts in models/ and the scenario's values.
+
+use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig};
+use super::template::{num, nums, render, section};
+use super::{PhysicsError, SceneSpec, ur5e};
+use nalgebra::{Isometry3, Point3, Vector3};
+
+const FINGER: &str = include_str!("../../../models/finger.xml");
+const SEGMENT: &str = include_str!("../../../models/finger_segment.xml");
+const PAD: &str = include_str!("../../../models/sensor_pad.xml");
+const UR5E: &str = include_str!("../../../models/ur5e.xml");
+const TABLE: &str = include_str!("../../../models/table.xml");
+
+/// Height of the pad's bump tip above the strip's inner face [m]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
+pub const PAD_HEIGHT_M: f64 = 0.0055;
+/// Clearance between the grown, straight strip's bump and the object [m], so growing does not push it.
+pub const GROW_CLEARANCE_M: f64 = 0.001;
+/// Weld of the hand to the kinematic arm target: solref time constant [s] and damping ratio. Stiff (it
+/// stands for the UR's joint servos) but above two default steps.
+pub const WELD_SOLREF: [f64; 2] = [0.005, 1.0];
+
+/// A model file without its leading comment (whose prose names the template's fields).
+fn body_of(text: &str) -> &str {
+    text.split_once("-->").map_or(text, |(_, rest)| rest)
+}
+
+/// The `<compiler>`, `<option>` and contact `<default>` every scene (and validation scene) shares.
+pub fn header(p: &PhysicsConfig) -> String {
+    let integrator = match p.integrator {
+        Integrator::Euler => "Euler",
+        Integrator::Rk4 => "RK4",
+        Integrator::Implicit => "implicit",
+        Integrator::Implicitfast => "implicitfast",
+    };
+    let cone = match p.cone {
+        Cone::Pyramidal => "pyramidal",
+        Cone::Elliptic => "elliptic",
+    };
+    format!(
+        r#"<compiler angle="radian" autolimits="true"/>
+  <option timestep="{dt}" integrator="{integrator}" cone="{cone}" impratio="{imp}" solver="Newton"
+          iterations="{it}" tolerance="{tol}" ls_iterations="{ls}" noslip_iterations="{ns}"
+          noslip_tolerance="{nstol}">
+    <flag energy="enable"/>
+  </option>
+  <default>
+    <geom solref="{tc} {dr}" solimp="{si} 0.5 2"/>
+  </default>"#,
+        dt = num(p.timestep_s),
+        imp = num(p.impratio),
+        it = p.iterations,
+        tol = num(p.tolerance),
+        ls = p.ls_iterations,
+        ns = p.noslip_iterations,
+        nstol = num(p.noslip_tolerance),
+        tc = num(p.contact_timeconst_s),
+        dr = num(p.contact_dampratio),
+        si = nums(&p.contact_solimp),
+    )
+}
+
+/// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
+/// document; `hand_pose` places the hand in its parent, `free` gives it a free joint (kinematic arm).
+pub fn finger(f: &FingerConfig, hand_pose: &Isometry3<f64>, free: bool) -> Result<String, PhysicsError> {
+    let n = f.segments as usize;
+    let l = f.segment_length_m();
+    let r = f.thickness_m / 2.0;
+    let seg_mass = f.density_kg_m3 * l * f.width_m * f.thickness_m;
+    let pad_seg = ((f.pad_position_m / l).floor() as usize).min(n - 1);
+    let pad_x = f.pad_position_m - pad_seg as f64 * l;
+    let pad = render(
+        body_of(PAD),
+        &[
+            ("x", num(pad_x)),
+            ("r", num(r)),
+            ("casing_y", num(r + 0.002)),
+            ("bump_y", num(r + 0.004)),
+            ("site_y", num(r + 0.005)),
+        ],
+    )?;
+    let segment_body = body_of(SEGMENT);
+    let mut chain = String::new();
+    for i in (0..n).rev() {
+        chain = render(
+            segment_body,
+            &[
+                ("i", i.to_string()),
+                ("x", num(if i == 0 { 0.0 } else { l })),
+                ("k_bend", num(f.bending_stiffness_n_m2 / l)),
+                ("d_bend", num(f.joint_damping_n_m_s)),
+                ("a_bend", num(f.joint_armature_kg_m2)),
+                ("max_curl", num(2.0)),
+                ("half_len", num(l / 2.0)),
+                ("half_width", num(f.width_m / 2.0)),
+                ("radius", num(r)),
+                ("mass", num(seg_mass)),
+                ("pad", if i == pad_seg { pad.clone() } else { String::new() }),
+                ("child", chain),
+            ],
+        )?;
+    }
+    let curl_terms: String =
+        (0..n).map(|i| format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(f.moment_arm_m))).collect();
+    let k = f.tendon_stiffness_n_m;
+    let k_elastic = f.relaxed_fraction * k;
+    let k_maxwell = (1.0 - f.relaxed_fraction) * k;
+    // The dashpot's node needs some inertia; 1e-3 kg keeps its own time constant (m / c) far below tau.
+    let creep_damping = f.relaxation_time_s * k_maxwell.max(1e-9);
+    let q = hand_pose.rotation.quaternion();
+    let p = hand_pose.translation.vector;
+    render(
+        body_of(FINGER),
+        &[
+            ("hand_pos", nums(&[p.x, p.y, p.z])),
+            ("hand_quat", nums(&[q.w, q.i, q.j, q.k])),
+            ("hand_joint", if free { "<freejoint name=\"hand\"/>".into() } else { String::new() }),
+            ("exit_z", num(f.exit_z_m)),
+            ("length", num(f.length_m)),
+            ("moment_arm", num(f.moment_arm_m)),
+            ("segments", chain),
+            ("motor_armature", num(f.motor_armature_kg)),
+            ("twine_range", nums(&[0.0, f.twine_max_m])),
+            ("growth_range", nums(&[0.0, f.length_m])),
+            ("creep_damping", num(creep_damping)),
+            ("creep_armature", num(1e-3)),
+            ("root_x", num(-f.length_m)),
+            ("k_elastic", num(k_elastic)),
+            ("k_maxwell", num(k_maxwell)),
+            ("curl_terms", curl_terms),
+            ("motor_kp", num(f.motor_kp_n_m)),
+            ("motor_kv", num(f.motor_kv_n_s_m)),
+        ],
+    )
+}
+
+/// Where the scene's parts stand at the start, in the world frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placement {
+    /// Tool-flange (= hand frame) pose at the start arm configuration.
+    pub hand: Isometry3<f64>,
+    /// Object footprint centre (its body origin) [m]; `None` when the scene has no object.
+    pub object: Option<Vector3<f64>>,
+    /// Height of the table plane [m].
+    pub table_z: f64,
+}
+
+/// Computes the start placement: the hand from forward kinematics of the start joint angles; the
+/// object (unless its position is given) beside the palm, [`GROW_CLEARANCE_M`] in front of it and as
+/// far beside the strip that the growing strip's pad passes it with the same clearance; the table under
+/// the object so that the strip's plane crosses the middle of the grip.
+pub fn placement(spec: &SceneSpec) -> Placement {
+    let hand = ur5e::forward(&spec.arm_q0);
+    let f = &spec.finger;
+    let Some(obj) = &spec.object else {
+        return Placement { hand, object: None, table_z: 0.0 };
+    };
+    let radius = obj.name.grip_radius_m();
+    let y = f.thickness_m / 2.0 + PAD_HEIGHT_M + GROW_CLEARANCE_M + radius;
+    let wrap = hand * Point3::new(radius + GROW_CLEARANCE_M, y, f.exit_z_m);
+    let base_z = wrap.z - obj.name.grip_height_m();
+    let (x, y) = match obj.position_m {
+        Some([x, y]) => (x, y),
+        None => (wrap.x, wrap.y),
+    };
+    Placement { hand, object: Some(Vector3::new(x, y, base_z)), table_z: base_z }
+}
+
+/// The full scene MJCF for `spec`, and where its parts start.
+pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
+    let place = placement(spec);
+    let mut worldbody = String::new();
+    let mut equality = String::new();
+    let mut actuator = String::new();
+    let mut tendon = String::new();
+    let mut sensor = String::new();
+
+    if spec.object.is_some() {
+        let table = TABLE.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
+        worldbody.push_str(section(&table, "worldbody"));
+        worldbody.push_str(section(spec.object.as_ref().map(|o| o.name.mjcf()).unwrap_or(""), "worldbody"));
+    }
+    let kinematic = spec.physics.arm_mode == ArmMode::Kinematic;
+    let finger_doc = if kinematic {
+        finger(&spec.finger, &place.hand, true)?
+    } else {
+        finger(&spec.finger, &Isometry3::identity(), false)?
+    };
+    let hand_body = section(&finger_doc, "worldbody");
+    if kinematic {
+        let q = place.hand.rotation.quaternion();
+        let p = place.hand.translation.vector;
+        worldbody.push_str(&format!(
+            "\n    <body name=\"arm_target\" mocap=\"true\" pos=\"{}\" quat=\"{}\"/>\n",
+            nums(&[p.x, p.y, p.z]),
+            nums(&[q.w, q.i, q.j, q.k])
+        ));
+        worldbody.push_str(hand_body);
+        equality.push_str(&format!(
+            "<weld name=\"hand_to_arm\" body1=\"hand\" body2=\"arm_target\" solref=\"{}\"/>",
+            nums(&WELD_SOLREF)
+        ));
+    } else {
+        let arm = render(UR5E, &[("hand", hand_body.to_string())])?;
+        worldbody.push_str(section(&arm, "worldbody"));
+        actuator.push_str(section(&arm, "actuator"));
+    }
+    actuator.push_str(section(&finger_doc, "actuator"));
+    tendon.push_str(section(&finger_doc, "tendon"));
+    sensor.push_str(section(&finger_doc, "sensor"));
+
+    let xml = format!(
+        "<mujoco model=\"tendril_cell\">\n  {header}\n  <worldbody>{worldbody}</worldbody>\n  \
+         <equality>{equality}</equality>\n  <tendon>{tendon}</tendon>\n  <actuator>{actuator}</actuator>\n  \
+         <sensor>{sensor}</sensor>\n</mujoco>\n",
+        header = header(&spec.physics),
+    );
+    Ok((xml, place))
+}
