@@ -13,6 +13,7 @@ pub mod config;
 pub mod scene;
 pub mod template;
 pub mod ur5e;
+pub mod validation;
 
 pub use config::{ArmMode, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig};
 pub use scene::{PhysicsReadout, Scene, SceneModel};
