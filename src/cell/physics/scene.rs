@@ -80,11 +80,6 @@ impl SceneModel {
             let p = placement.hand.translation.vector;
             model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, q.w, q.i, q.j, q.k]);
         }
-        if let Some(adr) = ids.arm_qpos {
-            for (k, a) in adr.iter().enumerate() {
-                model.qpos0_mut()[*a] = spec.arm_q0[k];
-            }
-        }
         Ok(Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids }))
     }
 
@@ -239,9 +234,12 @@ impl Scene {
     pub fn new(shared: Arc<SceneModel>) -> Scene {
         let mut data = MjData::new(shared.model.clone());
         let q0 = shared.spec.arm_q0;
-        if let Some(acts) = shared.ids.arm_act {
-            for (k, a) in acts.iter().enumerate() {
-                data.ctrl_mut()[*a] = q0[k];
+        // Hinge angles count from qpos0 (the model's zero pose), so the start pose is set in the data,
+        // not in the model; free joints (hand, object) start from their qpos0 set in SceneModel::build.
+        if let (Some(acts), Some(adrs)) = (shared.ids.arm_act, shared.ids.arm_qpos) {
+            for k in 0..6 {
+                data.ctrl_mut()[acts[k]] = q0[k];
+                data.qpos_mut()[adrs[k]] = q0[k];
             }
         }
         data.forward();
