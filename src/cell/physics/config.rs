@@ -93,14 +93,14 @@ pub struct PhysicsConfig {
 impl Default for PhysicsConfig {
     fn default() -> Self {
         PhysicsConfig {
-            timestep_s: 0.002,
+            timestep_s: 0.005,
             integrator: Integrator::Implicitfast,
             cone: Cone::Elliptic,
             impratio: 10.0,
             iterations: 50,
-            tolerance: 1e-10,
+            tolerance: 1e-8,
             ls_iterations: 20,
-            noslip_iterations: 4,
+            noslip_iterations: 10,
             noslip_tolerance: 1e-8,
             contact_timeconst_s: 0.01,
             contact_dampratio: 1.0,
@@ -188,7 +188,7 @@ pub struct FingerConfig {
 impl Default for FingerConfig {
     fn default() -> Self {
         FingerConfig {
-            segments: 10,
+            segments: 8,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,
