@@ -158,8 +158,11 @@ pub struct FingerConfig {
     pub bending_stiffness_n_m2: f64,
     /// Bending damping per joint [N m s/rad]; a choice that damps the strip's free flapping in ~0.1 s.
     pub joint_damping_n_m_s: f64,
-    /// Rotor-like inertia added to each bending joint [kg m^2]; keeps 1 g segments stable against stiff
-    /// contacts at the step size (modeling.md: armature fixed deep sinking of light finger links).
+    /// Inertia added to each bending joint [kg m^2]. Numerical, not physical: MuJoCo's soft contacts are
+    /// as stiff as the effective mass behind them, and a 1 g segment sank up to 12 mm into the objects
+    /// (and tunnelled through the shampoo) at 5 ms; 1e-4 keeps penetration near 1 mm in every grasp tried
+    /// (modeling.md saw the same fix). Side effect: the strip's own curl mode has a period of ~0.6 s,
+    /// still much faster than the paper's 5 s force loop; it does not add inertia to the object.
     pub joint_armature_kg_m2: f64,
     /// Tendon offset from the strip's neutral axis [m] (moment arm of the tendon on each joint). 3 mm.
     pub moment_arm_m: f64,
@@ -176,10 +179,13 @@ pub struct FingerConfig {
     pub motor_kp_n_m: f64,
     /// Position-servo damping of both motors [N s/m]; near critical for the armature.
     pub motor_kv_n_s_m: f64,
+    /// Largest speed of either motor's output [m/s]: commands further away are approached at this
+    /// speed. MX-106 no-load speed 45 rpm at 12 V (hardware.md) on the 10 mm spool = 0.047 m/s.
+    pub motor_max_speed_m_s: f64,
     /// Largest twine (tendon wound in) [m].
     pub twine_max_m: f64,
     /// Distance of the sensor pad's centre from the strip's base [m] (on the sleeve, near the guide,
-    /// paper Sec. V). 35 mm keeps the largest object (30 mm radius) clear of the guide.
+    /// paper Sec. V). 35 mm: inside the wrap of a 12-14 mm radius handle or neck.
     pub pad_position_m: f64,
     /// Distance below the flange at which the strip leaves the guide [m] (hand length). A choice.
     pub exit_z_m: f64,
@@ -195,7 +201,7 @@ impl Default for FingerConfig {
             density_kg_m3: 1200.0,
             bending_stiffness_n_m2: 2e-4,
             joint_damping_n_m_s: 2e-4,
-            joint_armature_kg_m2: 2e-6,
+            joint_armature_kg_m2: 1e-4,
             moment_arm_m: 0.003,
             tendon_stiffness_n_m: 2000.0,
             relaxed_fraction: 0.5,
@@ -203,6 +209,7 @@ impl Default for FingerConfig {
             motor_armature_kg: 2.0,
             motor_kp_n_m: 20000.0,
             motor_kv_n_s_m: 400.0,
+            motor_max_speed_m_s: 0.047,
             twine_max_m: 0.06,
             pad_position_m: 0.035,
             exit_z_m: 0.1,
@@ -236,6 +243,7 @@ impl Validate for FingerConfig {
         at.positive("motor_armature_kg", self.motor_armature_kg);
         at.positive("motor_kp_n_m", self.motor_kp_n_m);
         at.non_negative("motor_kv_n_s_m", self.motor_kv_n_s_m);
+        at.positive("motor_max_speed_m_s", self.motor_max_speed_m_s);
         at.positive("twine_max_m", self.twine_max_m);
         at.require(
             "pad_position_m",
@@ -319,7 +327,7 @@ impl ObjectName {
         match self {
             ObjectName::Crimper => 0.0125,
             ObjectName::Hammer => 0.014,
-            ObjectName::Shampoo => 0.03,
+            ObjectName::Shampoo => 0.012,
         }
     }
 
@@ -328,7 +336,7 @@ impl ObjectName {
         match self {
             ObjectName::Crimper => 0.122,
             ObjectName::Hammer => 0.154,
-            ObjectName::Shampoo => 0.11,
+            ObjectName::Shampoo => 0.17,
         }
     }
 }

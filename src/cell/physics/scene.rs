@@ -195,6 +195,8 @@ pub struct PhysicsReadout {
     pub growth_m: f64,
     /// Tendon wound in by the twine motor [m] (actual motor position).
     pub twine_m: f64,
+    /// The twine servo's current setpoint [m] (the command after the motor speed limit).
+    pub twine_setpoint_m: f64,
     /// Creep elongation of the Maxwell branch [m].
     pub creep_m: f64,
     /// Tendon tension, both branches [N].
@@ -211,6 +213,8 @@ pub struct Scene {
     data: MjData<Arc<MjModel>>,
     arm_target: [f64; 6],
     arm_q: [f64; 6],
+    /// Commanded growth and twine [m]; the servo setpoints move towards them at the motor speed.
+    motor_target: [f64; 2],
     warnings_seen: [i32; 8],
 }
 
@@ -243,7 +247,7 @@ impl Scene {
             }
         }
         data.forward();
-        Scene { shared, data, arm_target: q0, arm_q: q0, warnings_seen: [0; 8] }
+        Scene { shared, data, arm_target: q0, arm_q: q0, motor_target: [0.0; 2], warnings_seen: [0; 8] }
     }
 
     /// The shared model.
@@ -267,23 +271,23 @@ impl Scene {
     }
 
     /// Commands the finger growth (strip length out of the guide) [m], clamped to 0..finger.length_m.
+    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
     pub fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
         if !growth_m.is_finite() {
             return Err(PhysicsError::BadInput { what: "growth", value: growth_m });
         }
-        let a = self.shared.ids.growth_act;
-        self.data.ctrl_mut()[a] = growth_m.clamp(0.0, self.shared.spec.finger.length_m);
+        self.motor_target[0] = growth_m.clamp(0.0, self.shared.spec.finger.length_m);
         Ok(())
     }
 
     /// Commands the twine motor: metres of tendon wound in (the twining/curl input, the PID's output),
     /// clamped to 0..finger.twine_max_m. More twine curls the strip tighter and raises the grip force.
+    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
     pub fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError> {
         if !twine_m.is_finite() {
             return Err(PhysicsError::BadInput { what: "twine", value: twine_m });
         }
-        let a = self.shared.ids.twine_act;
-        self.data.ctrl_mut()[a] = twine_m.clamp(0.0, self.shared.spec.finger.twine_max_m);
+        self.motor_target[1] = twine_m.clamp(0.0, self.shared.spec.finger.twine_max_m);
         Ok(())
     }
 
@@ -306,6 +310,12 @@ impl Scene {
     /// Advances one step; a diverging state is a [`PhysicsError::Diverged`] with the time.
     pub fn step(&mut self) -> Result<(), PhysicsError> {
         let t0 = self.data.time();
+        let max = self.shared.spec.finger.motor_max_speed_m_s * self.timestep();
+        let ids = &self.shared.ids;
+        for (act, target) in [(ids.growth_act, self.motor_target[0]), (ids.twine_act, self.motor_target[1])] {
+            let ctrl = &mut self.data.ctrl_mut()[act];
+            *ctrl += (target - *ctrl).clamp(-max, max);
+        }
         if let Some(mocap) = self.shared.ids.mocap {
             let max = self.shared.spec.physics.arm_max_speed_rad_s * self.timestep();
             for k in 0..6 {
@@ -405,6 +415,7 @@ impl Scene {
             hand_pos_m: hand_p.into(),
             growth_m: qpos[ids.growth_qpos],
             twine_m: qpos[ids.twine_qpos],
+            twine_setpoint_m: self.data.ctrl()[ids.twine_act],
             creep_m: qpos[ids.creep_qpos],
             tendon_tension_n: self.tendon_tension_n(),
             arm_q: match ids.arm_qpos {
