@@ -5,7 +5,7 @@ use super::{FingerConfig, ObjectConfig, PhysicsConfig, PhysicsError, Scene, Scen
 use crate::scenario::{Checker, Validate};
 use serde::Deserialize;
 
-/// The script: grow, twine, hold, lift; every section optional.
+/// The script: grow, twine, hold, lift (time 0 = start; printed times are simulated seconds).
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct CheckScenario {
@@ -25,7 +25,7 @@ pub struct CheckScenario {
 pub struct CheckScript {
     /// Growth commanded at t = 0 [m].
     pub growth_m: f64,
-    /// Twine ramped in linearly from t = 1 s to t = 2 s [m].
+    /// Twine ramped in linearly over 1 s once the strip is grown [m].
     pub twine_m: f64,
     /// Hold before lifting [s].
     pub hold_s: f64,
@@ -78,7 +78,10 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     };
     let mut scene = Scene::build(&spec)?;
     let c = &s.check;
-    let end = 2.0 + c.hold_s + c.after_lift_s;
+    // Growth runs at the motor's speed; the twine ramp starts 0.5 s after it is done.
+    let t_twine = c.growth_m / s.finger.motor_max_speed_m_s + 0.5;
+    let t_lift = t_twine + 1.0 + c.hold_s;
+    let end = t_lift + c.after_lift_s;
     let every = (c.print_every_s / scene.timestep()).round().max(1.0) as usize;
     println!("t_s pad_N grip_N contacts twine_m creep_m tension_N obj_in_hand_z_mm slip_mm_s hand_z_m");
     let mut k = 0usize;
@@ -88,9 +91,9 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     let mut seed = ur5e::HOME;
     while scene.time() < end {
         let t = scene.time();
-        scene.set_twine(c.twine_m * ((t - 1.0) / 1.0).clamp(0.0, 1.0))?;
-        if t >= 2.0 + c.hold_s {
-            let frac = ((t - 2.0 - c.hold_s) / c.lift_duration_s).min(1.0);
+        scene.set_twine(c.twine_m * (t - t_twine).clamp(0.0, 1.0))?;
+        if t >= t_lift {
+            let frac = ((t - t_lift) / c.lift_duration_s).min(1.0);
             // Smooth (cosine) profile: zero velocity at both ends.
             let dz = c.lift_m * 0.5 * (1.0 - (std::f64::consts::PI * frac).cos());
             let mut target = start;
