@@ -11,17 +11,19 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 use tendril::cell::physics::{ArmMode, PhysicsConfig, Scene, SceneSpec, ur5e, validation};
 
-/// A scene already holding the object: grown (1 s), twined to 30 mm (1 s), settled (0.5 s).
+/// A scene already holding the object: grown (3.5 s at the motor's speed), twined to 32 mm (1 s),
+/// settled (0.5 s).
 fn grasped(spec: &SceneSpec) -> Scene {
     let mut s = Scene::build(spec).expect("scene builds");
     s.set_growth(spec.finger.length_m).unwrap();
-    s.run_for(1.0).unwrap();
+    s.run_for(3.5).unwrap();
     let n = (1.0 / s.timestep()).round() as usize;
     for k in 1..=n {
-        s.set_twine(0.03 * k as f64 / n as f64).unwrap();
+        s.set_twine(0.032 * k as f64 / n as f64).unwrap();
         s.step().unwrap();
     }
     s.run_for(0.5).unwrap();
+    assert!(s.readout().grip_contacts > 0, "bench scene must be grasping");
     s
 }
 

@@ -15,6 +15,7 @@ pub mod template;
 pub mod ur5e;
 pub mod validation;
 
+pub use compose::Placement;
 pub use config::{ArmMode, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig};
 pub use scene::{PhysicsReadout, Scene, SceneModel};
 

@@ -26,6 +26,8 @@ struct Ids {
     pad_geoms: Vec<usize>,
     /// Geoms of the strip and the pad.
     finger_geoms: Vec<usize>,
+    /// The palm beside the guide exit.
+    palm_geom: Vec<usize>,
     /// The object's geoms (empty without object).
     object_geoms: Vec<usize>,
     object_body: Option<usize>,
@@ -124,6 +126,7 @@ impl SceneModel {
         Ok(Ids {
             pad_geoms,
             finger_geoms,
+            palm_geom: vec![geom("palm")?],
             object_geoms,
             object_body,
             object_grip,
@@ -174,6 +177,9 @@ pub struct PhysicsReadout {
     pub pad_force_n: f64,
     /// Sum of the normal forces between the object and the whole finger, pad included [N].
     pub grip_force_n: f64,
+    /// Normal force between the object and the palm beside the guide exit [N] (not part of the grip
+    /// force: the palm is the hand, not the finger).
+    pub palm_force_n: f64,
     /// Number of active object-finger contacts.
     pub grip_contacts: usize,
     /// Whether the object touches the finger at all.
@@ -402,6 +408,7 @@ impl Scene {
         let qpos = self.data.qpos();
         let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
         let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
+        let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
         let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
         let hq = self.data.xquat()[ids.hand_body];
         let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
@@ -410,6 +417,7 @@ impl Scene {
             time_s: self.data.time(),
             pad_force_n,
             grip_force_n,
+            palm_force_n,
             grip_contacts,
             touching: grip_contacts > 0,
             hand_pos_m: hand_p.into(),
@@ -459,5 +467,18 @@ impl Scene {
     /// Geom ids of the object.
     pub fn object_geoms(&self) -> &[usize] {
         &self.shared.ids.object_geoms
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_can_move_to_other_threads_and_share_the_model() {
+        fn send<T: Send>() {}
+        fn send_sync<T: Send + Sync>() {}
+        send::<Scene>();
+        send_sync::<SceneModel>();
     }
 }
