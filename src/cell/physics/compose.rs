@@ -11,10 +11,14 @@ const PAD: &str = include_str!("../../../models/sensor_pad.xml");
 const UR5E: &str = include_str!("../../../models/ur5e.xml");
 const TABLE: &str = include_str!("../../../models/table.xml");
 
-/// Height of the pad's bump tip above the strip's inner face [m]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
+/// Height of the pad's bump tip above the casing's base [m]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
 pub const PAD_HEIGHT_M: f64 = 0.0055;
 /// Clearance between the grown, straight strip's bump and the object [m], so growing does not push it.
 pub const GROW_CLEARANCE_M: f64 = 0.001;
+/// Gap between the object and the palm at the start [m]: touching (0.2 mm), so the wrap presses it on
+/// the palm from the start instead of dragging it there part-way through tightening (which shifted the
+/// load off the pad by ~10 %).
+pub const PALM_GAP_M: f64 = 0.0002;
 /// Weld of the hand to the kinematic arm target: solref time constant [s] and damping ratio. Stiff (it
 /// stands for the UR's joint servos) but above two default steps.
 pub const WELD_SOLREF: [f64; 2] = [0.005, 1.0];
@@ -70,14 +74,16 @@ pub fn finger(f: &FingerConfig, hand_pose: &Isometry3<f64>, free: bool) -> Resul
     let seg_mass = f.density_kg_m3 * l * f.width_m * f.thickness_m;
     let pad_seg = ((f.pad_position_m / l).floor() as usize).min(n - 1);
     let pad_x = f.pad_position_m - pad_seg as f64 * l;
+    // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
+    let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
     let pad = render(
         body_of(PAD),
         &[
             ("x", num(pad_x)),
             ("r", num(r)),
-            ("casing_y", num(r + 0.002)),
-            ("bump_y", num(r + 0.004)),
-            ("site_y", num(r + 0.005)),
+            ("casing_y", num(r + 0.002 + sink)),
+            ("bump_y", num(r + 0.004 + sink)),
+            ("site_y", num(r + 0.005 + sink)),
         ],
     )?;
     let segment_body = body_of(SEGMENT);
@@ -151,8 +157,8 @@ pub struct Placement {
 }
 
 /// Computes the start placement: the hand from forward kinematics of the start joint angles; the
-/// object (unless its position is given) beside the palm, [`GROW_CLEARANCE_M`] in front of it and as
-/// far beside the strip that the growing strip's pad passes it with the same clearance; the table under
+/// object (unless its position is given) against the palm ([`PALM_GAP_M`]) and so far beside the strip
+/// that the growing strip's pad passes it with [`GROW_CLEARANCE_M`] to spare; the table under
 /// the object so that the strip's plane crosses the middle of the grip.
 pub fn placement(spec: &SceneSpec) -> Placement {
     let hand = ur5e::forward(&spec.arm_q0);
@@ -161,8 +167,8 @@ pub fn placement(spec: &SceneSpec) -> Placement {
         return Placement { hand, object: None, table_z: 0.0 };
     };
     let radius = obj.name.grip_radius_m();
-    let y = f.thickness_m / 2.0 + PAD_HEIGHT_M + GROW_CLEARANCE_M + radius;
-    let wrap = hand * Point3::new(radius + GROW_CLEARANCE_M, y, f.exit_z_m);
+    let y = f.thickness_m / 2.0 + f.pad_protrusion_m + GROW_CLEARANCE_M + radius;
+    let wrap = hand * Point3::new(radius + PALM_GAP_M, y, f.exit_z_m);
     let base_z = wrap.z - obj.name.grip_height_m();
     let (x, y) = match obj.position_m {
         Some([x, y]) => (x, y),

@@ -185,8 +185,17 @@ pub struct FingerConfig {
     /// Largest twine (tendon wound in) [m].
     pub twine_max_m: f64,
     /// Distance of the sensor pad's centre from the strip's base [m] (on the sleeve, near the guide,
-    /// paper Sec. V). 35 mm: inside the wrap of a 12-14 mm radius handle or neck.
+    /// paper Sec. V). 43.75 mm: inside the wrap of a 12-14 mm radius handle or neck, and the middle of
+    /// the third of 8 segments: a flat segment touches a round handle at its middle, so a pad there is
+    /// loaded steadily (a pad over a joint was loaded erratically). Keep it mid-segment when changing
+    /// `segments`.
     pub pad_position_m: f64,
+    /// Height of the pad's bump tip above the strip's inner face [m]. The casing is 4 mm tall and the
+    /// bump 1.5 mm (5.5 mm in all) but how deep the casing sits in the sleeve is not published: this sets
+    /// how much of the wrap's force the pad takes. Tunable; 2.5 mm (casing 3 mm recessed) gives the pad
+    /// ~20-25 % of the strip's normal force (5.5 mm: 30-45 %). The paper's setpoints (0.6-1.6 N on the
+    /// pad for objects needing 4-8 N of normal force at their friction) suggest 10-20 %.
+    pub pad_protrusion_m: f64,
     /// Distance below the flange at which the strip leaves the guide [m] (hand length). A choice.
     pub exit_z_m: f64,
 }
@@ -211,7 +220,8 @@ impl Default for FingerConfig {
             motor_kv_n_s_m: 400.0,
             motor_max_speed_m_s: 0.047,
             twine_max_m: 0.06,
-            pad_position_m: 0.035,
+            pad_position_m: 0.04375,
+            pad_protrusion_m: 0.0025,
             exit_z_m: 0.1,
         }
     }
@@ -255,6 +265,7 @@ impl Validate for FingerConfig {
                 )
             },
         );
+        at.in_range("pad_protrusion_m", self.pad_protrusion_m, 0.0005, 0.0055);
         at.positive("exit_z_m", self.exit_z_m);
     }
 }
