@@ -37,18 +37,25 @@ pub struct CheckScript {
     pub after_lift_s: f64,
     /// Print period [s].
     pub print_every_s: f64,
+    /// Pad-force setpoint [N] of a plain integral loop on the twine, active after the twine ramp;
+    /// 0 = open loop (the twine stays where the ramp left it). A stand-in for the PID, for tuning only.
+    pub pad_setpoint_n: f64,
+    /// Gain of that loop [m of tendon per N per s].
+    pub loop_gain_m_per_n_s: f64,
 }
 
 impl Default for CheckScript {
     fn default() -> Self {
         CheckScript {
             growth_m: 0.14,
-            twine_m: 0.02,
+            twine_m: 0.03,
             hold_s: 3.0,
             lift_m: 0.1,
             lift_duration_s: 2.0,
             after_lift_s: 3.0,
             print_every_s: 0.25,
+            pad_setpoint_n: 0.0,
+            loop_gain_m_per_n_s: 0.002,
         }
     }
 }
@@ -65,6 +72,8 @@ impl Validate for CheckScenario {
         at.positive("check.lift_duration_s", self.check.lift_duration_s);
         at.non_negative("check.after_lift_s", self.check.after_lift_s);
         at.positive("check.print_every_s", self.check.print_every_s);
+        at.non_negative("check.pad_setpoint_n", self.check.pad_setpoint_n);
+        at.non_negative("check.loop_gain_m_per_n_s", self.check.loop_gain_m_per_n_s);
     }
 }
 
@@ -89,9 +98,16 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     scene.set_growth(c.growth_m)?;
     let start = ur5e::forward(&ur5e::HOME);
     let mut seed = ur5e::HOME;
+    let mut twine = 0.0;
     while scene.time() < end {
         let t = scene.time();
-        scene.set_twine(c.twine_m * (t - t_twine).clamp(0.0, 1.0))?;
+        if c.pad_setpoint_n > 0.0 && t > t_twine + 1.0 {
+            let error = c.pad_setpoint_n - scene.readout().pad_force_n;
+            twine += c.loop_gain_m_per_n_s * error * scene.timestep();
+        } else {
+            twine = c.twine_m * (t - t_twine).clamp(0.0, 1.0);
+        }
+        scene.set_twine(twine)?;
         if t >= t_lift {
             let frac = ((t - t_lift) / c.lift_duration_s).min(1.0);
             // Smooth (cosine) profile: zero velocity at both ends.
