@@ -260,3 +260,32 @@ fn bad_inputs_are_errors_not_nan() {
     spec.finger.segments = 1;
     assert!(matches!(SceneModel::build(&spec), Err(PhysicsError::Config { key, .. }) if key == "finger.segments"));
 }
+
+#[test]
+fn arm_models_put_the_hand_where_dh_kinematics_says() {
+    use tendril::cell::physics::{ArmMode, ur5e};
+    let q = [-1.3, -1.9, 1.7, -1.4, -1.5, 0.4];
+    for mode in [ArmMode::Kinematic, ArmMode::Dynamic] {
+        let mut spec = SceneSpec { object: None, arm_q0: q, ..SceneSpec::default() };
+        spec.physics.arm_mode = mode;
+        let s = Scene::build(&spec).unwrap();
+        // At the start both modes are exactly at the pose (MJCF body chain vs DH product).
+        let fk = ur5e::forward(&q).translation.vector;
+        let hand = s.readout().hand_pos_m;
+        let err = ((hand[0] - fk.x).powi(2) + (hand[1] - fk.y).powi(2) + (hand[2] - fk.z).powi(2)).sqrt();
+        assert!(err < 1e-9, "{mode:?}: hand {hand:?} vs DH {fk}");
+    }
+    // Moving: the hand follows a new target within 2 mm once settled, in both modes.
+    let target = [-1.5, -1.7, 1.8, -1.7, -1.57, 0.0];
+    for mode in [ArmMode::Kinematic, ArmMode::Dynamic] {
+        let mut spec = SceneSpec { object: None, arm_q0: q, ..SceneSpec::default() };
+        spec.physics.arm_mode = mode;
+        let mut s = Scene::build(&spec).unwrap();
+        s.set_arm_target(target).unwrap();
+        s.run_for(2.0).unwrap();
+        let fk = ur5e::forward(&target).translation.vector;
+        let hand = s.readout().hand_pos_m;
+        let err = ((hand[0] - fk.x).powi(2) + (hand[1] - fk.y).powi(2) + (hand[2] - fk.z).powi(2)).sqrt();
+        assert!(err < 2e-3, "{mode:?}: hand {hand:?} vs DH {fk} ({err} m)");
+    }
+}
