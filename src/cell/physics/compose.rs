@@ -19,9 +19,6 @@ pub const GROW_CLEARANCE_M: f64 = 0.001;
 /// the palm from the start instead of dragging it there part-way through tightening (which shifted the
 /// load off the pad by ~10 %).
 pub const PALM_GAP_M: f64 = 0.0002;
-/// Weld of the hand to the kinematic arm target: solref time constant [s] and damping ratio. Stiff (it
-/// stands for the UR's joint servos) but above two default steps.
-pub const WELD_SOLREF: [f64; 2] = [0.005, 1.0];
 
 /// A model file without its leading comment (whose prose names the template's fields).
 fn body_of(text: &str) -> &str {
@@ -66,8 +63,8 @@ pub fn header(p: &PhysicsConfig) -> String {
 }
 
 /// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
-/// document; `hand_pose` places the hand in its parent, `free` gives it a free joint (kinematic arm).
-pub fn finger(f: &FingerConfig, hand_pose: &Isometry3<f64>, free: bool) -> Result<String, PhysicsError> {
+/// document whose hand body goes into the arm's flange.
+pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
     let n = f.segments as usize;
     let l = f.segment_length_m();
     let r = f.thickness_m / 2.0;
@@ -94,6 +91,8 @@ pub fn finger(f: &FingerConfig, hand_pose: &Isometry3<f64>, free: bool) -> Resul
             &[
                 ("i", i.to_string()),
                 ("x", num(if i == 0 { 0.0 } else { l })),
+                // Helix: each segment one step towards the flange (-z in the hand frame).
+                ("z", num(if i == 0 { 0.0 } else { -f.helix_slope * l })),
                 ("k_bend", num(f.bending_stiffness_n_m2 / l)),
                 ("d_bend", num(f.joint_damping_n_m_s)),
                 ("a_bend", num(f.joint_armature_kg_m2)),
@@ -114,14 +113,9 @@ pub fn finger(f: &FingerConfig, hand_pose: &Isometry3<f64>, free: bool) -> Resul
     let k_maxwell = (1.0 - f.relaxed_fraction) * k;
     // The dashpot's node needs some inertia; 1e-3 kg keeps its own time constant (m / c) far below tau.
     let creep_damping = f.relaxation_time_s * k_maxwell.max(1e-9);
-    let q = hand_pose.rotation.quaternion();
-    let p = hand_pose.translation.vector;
     render(
         body_of(FINGER),
         &[
-            ("hand_pos", nums(&[p.x, p.y, p.z])),
-            ("hand_quat", nums(&[q.w, q.i, q.j, q.k])),
-            ("hand_joint", if free { "<freejoint name=\"hand\"/>".into() } else { String::new() }),
             ("exit_z", num(f.exit_z_m)),
             ("length", num(f.length_m)),
             ("moment_arm", num(f.moment_arm_m)),
@@ -134,7 +128,7 @@ pub fn finger(f: &FingerConfig, hand_pose: &Isometry3<f64>, free: bool) -> Resul
             ("root_x", num(-f.length_m)),
             ("half_length", num(f.length_m / 2.0)),
             ("guide_x", num(-f.length_m / 2.0)),
-            ("guide_half_width", num(f.width_m / 2.0 + 0.002)),
+            ("guide_half_width", num(f.width_m / 2.0 + 0.002 + f.helix_slope * f.length_m)),
             ("wall_y", num(r + 0.0012)),
             ("k_elastic", num(k_elastic)),
             ("k_maxwell", num(k_maxwell)),
@@ -181,7 +175,6 @@ pub fn placement(spec: &SceneSpec) -> Placement {
 pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     let place = placement(spec);
     let mut worldbody = String::new();
-    let mut equality = String::new();
     let mut actuator = String::new();
     let mut tendon = String::new();
     let mut sensor = String::new();
@@ -191,29 +184,12 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
         worldbody.push_str(section(&table, "worldbody"));
         worldbody.push_str(section(spec.object.as_ref().map(|o| o.name.mjcf()).unwrap_or(""), "worldbody"));
     }
-    let kinematic = spec.physics.arm_mode == ArmMode::Kinematic;
-    let finger_doc = if kinematic {
-        finger(&spec.finger, &place.hand, true)?
-    } else {
-        finger(&spec.finger, &Isometry3::identity(), false)?
-    };
-    let hand_body = section(&finger_doc, "worldbody");
-    if kinematic {
-        let q = place.hand.rotation.quaternion();
-        let p = place.hand.translation.vector;
-        worldbody.push_str(&format!(
-            "\n    <body name=\"arm_target\" mocap=\"true\" pos=\"{}\" quat=\"{}\"/>\n",
-            nums(&[p.x, p.y, p.z]),
-            nums(&[q.w, q.i, q.j, q.k])
-        ));
-        worldbody.push_str(hand_body);
-        equality.push_str(&format!(
-            "<weld name=\"hand_to_arm\" body1=\"hand\" body2=\"arm_target\" solref=\"{}\"/>",
-            nums(&WELD_SOLREF)
-        ));
-    } else {
-        let arm = render(UR5E, &[("hand", hand_body.to_string())])?;
-        worldbody.push_str(section(&arm, "worldbody"));
+    // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
+    // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
+    let finger_doc = finger(&spec.finger)?;
+    let arm = render(UR5E, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
+    worldbody.push_str(section(&arm, "worldbody"));
+    if spec.physics.arm_mode == ArmMode::Dynamic {
         actuator.push_str(section(&arm, "actuator"));
     }
     actuator.push_str(section(&finger_doc, "actuator"));
@@ -222,7 +198,7 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
 
     let xml = format!(
         "<mujoco model=\"tendril_cell\">\n  {header}\n  <worldbody>{worldbody}</worldbody>\n  \
-         <equality>{equality}</equality>\n  <tendon>{tendon}</tendon>\n  <actuator>{actuator}</actuator>\n  \
+         <tendon>{tendon}</tendon>\n  <actuator>{actuator}</actuator>\n  \
          <sensor>{sensor}</sensor>\n</mujoco>\n",
         header = header(&spec.physics),
     );

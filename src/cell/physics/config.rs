@@ -31,9 +31,11 @@ pub enum Cone {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ArmMode {
-    /// No arm dynamics: the joint targets go through DH forward kinematics to a mocap body, and the hand
-    /// (a free body) is welded to it. Cheapest; the UR's own servo loop is stiff enough that the hand
-    /// follows its trajectory.
+    /// Prescribed arm motion: each step the six joints are set to the commanded angles (rate-limited
+    /// to `arm_max_speed_rad_s`) with the matching joint velocities, so the hand moves exactly along the
+    /// UR's trajectory and has the velocity friction needs (a mocap body would have none). The joints
+    /// carry a large armature so contact forces do not move the arm within a step. The UR's own servo
+    /// loop is stiff enough that the real hand follows its trajectory too. Cheapest (no servos).
     Kinematic,
     /// The six joints with masses, gravity compensation and position servos (models/ur5e.xml).
     Dynamic,
@@ -190,6 +192,11 @@ pub struct FingerConfig {
     /// loaded steadily (a pad over a joint was loaded erratically). Keep it mid-segment when changing
     /// `segments`.
     pub pad_position_m: f64,
+    /// Rise of the strip per metre along it (dimensionless): the real strip twines as a helix, so its
+    /// second turn lies above the first instead of wedging between the first turn and the object.
+    /// Modelled as a step of `helix_slope * segment length` between segments (towards the flange).
+    /// 0.27: one turn around a 13 mm radius handle (82 mm of strip) rises by the strip's width plus 2 mm.
+    pub helix_slope: f64,
     /// Height of the pad's bump tip above the strip's inner face [m]. The casing is 4 mm tall and the
     /// bump 1.5 mm (5.5 mm in all) but how deep the casing sits in the sleeve is not published: this sets
     /// how much of the wrap's force the pad takes. Tunable; 2.5 mm (casing 3 mm recessed) gives the pad
@@ -222,6 +229,7 @@ impl Default for FingerConfig {
             twine_max_m: 0.06,
             pad_position_m: 0.04375,
             pad_protrusion_m: 0.0025,
+            helix_slope: 0.27,
             exit_z_m: 0.1,
         }
     }
@@ -266,6 +274,7 @@ impl Validate for FingerConfig {
             },
         );
         at.in_range("pad_protrusion_m", self.pad_protrusion_m, 0.0005, 0.0055);
+        at.in_range("helix_slope", self.helix_slope, 0.0, 1.0);
         at.positive("exit_z_m", self.exit_z_m);
     }
 }
@@ -342,12 +351,13 @@ impl ObjectName {
         }
     }
 
-    /// Height of the grip capsule's centre above the object's footprint [m] (models/objects/*.xml).
+    /// Height above the object's footprint at which the strip leaves the guide and starts its first
+    /// turn [m]; the helix rises from there, along the grip capsule (models/objects/*.xml).
     pub fn grip_height_m(self) -> f64 {
         match self {
-            ObjectName::Crimper => 0.122,
-            ObjectName::Hammer => 0.154,
-            ObjectName::Shampoo => 0.17,
+            ObjectName::Crimper => 0.1,
+            ObjectName::Hammer => 0.13,
+            ObjectName::Shampoo => 0.162,
         }
     }
 }

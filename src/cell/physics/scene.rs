@@ -2,7 +2,7 @@
 
 use super::compose::{self, Placement};
 use super::config::ArmMode;
-use super::{Divergence, PhysicsError, SceneSpec, ur5e};
+use super::{Divergence, PhysicsError, SceneSpec};
 use crate::scenario::{Checker, Validate};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtWarning};
 use mujoco_rs::prelude::{MjData, MjModel};
@@ -34,14 +34,14 @@ struct Ids {
     object_grip: Option<usize>,
     object_qpos: Option<usize>,
     hand_body: usize,
-    hand_qpos: Option<usize>,
-    mocap: Option<usize>,
     growth_qpos: usize,
     twine_qpos: usize,
     creep_qpos: usize,
     growth_act: usize,
     twine_act: usize,
-    arm_qpos: Option<[usize; 6]>,
+    arm_qpos: [usize; 6],
+    arm_dof: [usize; 6],
+    /// Servo actuators of the arm (dynamic mode only).
     arm_act: Option<[usize; 6]>,
     tendon_elastic: usize,
     tendon_maxwell: usize,
@@ -77,10 +77,11 @@ impl SceneModel {
                 model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, 1.0, 0.0, 0.0, 0.0]);
             }
         }
-        if let Some(adr) = ids.hand_qpos {
-            let q = placement.hand.rotation.quaternion();
-            let p = placement.hand.translation.vector;
-            model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, q.w, q.i, q.j, q.k]);
+        if spec.physics.arm_mode == ArmMode::Kinematic {
+            // Prescribed motion: the arm must not give way to contact forces within a step.
+            for d in ids.arm_dof {
+                model.dof_armature_mut()[d] = KINEMATIC_ARM_ARMATURE;
+            }
         }
         Ok(Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids }))
     }
@@ -103,24 +104,22 @@ impl SceneModel {
         } else {
             (Vec::new(), None, None, None)
         };
-        let kinematic = spec.physics.arm_mode == ArmMode::Kinematic;
         let names = ["shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"];
-        let (arm_qpos, arm_act) = if kinematic {
-            (None, None)
-        } else {
-            let mut q = [0; 6];
-            let mut a = [0; 6];
-            for k in 0..6 {
-                q[k] = qpos(names[k])?;
-                a[k] = act(names[k])?;
+        let mut arm_qpos = [0; 6];
+        let mut arm_dof = [0; 6];
+        for k in 0..6 {
+            arm_qpos[k] = qpos(names[k])?;
+            arm_dof[k] = m.jnt_dofadr()[joint(names[k])?] as usize;
+        }
+        let arm_act = match spec.physics.arm_mode {
+            ArmMode::Kinematic => None,
+            ArmMode::Dynamic => {
+                let mut a = [0; 6];
+                for k in 0..6 {
+                    a[k] = act(names[k])?;
+                }
+                Some(a)
             }
-            (Some(q), Some(a))
-        };
-        let mocap = if kinematic {
-            let body = id(m, mjOBJ_BODY, "body", "arm_target")?;
-            Some(m.body_mocapid()[body] as usize)
-        } else {
-            None
         };
         let touch = id(m, mjOBJ_SENSOR, "sensor", "pad_touch")?;
         Ok(Ids {
@@ -132,14 +131,13 @@ impl SceneModel {
             object_grip,
             object_qpos,
             hand_body: id(m, mjOBJ_BODY, "body", "hand")?,
-            hand_qpos: if kinematic { Some(qpos("hand")?) } else { None },
-            mocap,
             growth_qpos: qpos("growth")?,
             twine_qpos: qpos("twine")?,
             creep_qpos: qpos("creep")?,
             growth_act: act("growth")?,
             twine_act: act("twine")?,
             arm_qpos,
+            arm_dof,
             arm_act,
             tendon_elastic: id(m, mjOBJ_TENDON, "tendon", "tendon_elastic")?,
             tendon_maxwell: id(m, mjOBJ_TENDON, "tendon", "tendon_maxwell")?,
@@ -224,6 +222,10 @@ pub struct Scene {
     warnings_seen: [i32; 8],
 }
 
+/// Armature of the arm joints in the kinematic mode [kg m^2]: large enough that a few newtons of
+/// contact force do not turn a joint within a step (their motion is prescribed anyway).
+const KINEMATIC_ARM_ARMATURE: f64 = 1000.0;
+
 /// MuJoCo warnings that mean the run is not trustworthy.
 const FATAL_WARNINGS: [(mjtWarning, &str); 6] = [
     (mjtWarning::mjWARN_INERTIA, "bad inertia"),
@@ -245,11 +247,13 @@ impl Scene {
         let mut data = MjData::new(shared.model.clone());
         let q0 = shared.spec.arm_q0;
         // Hinge angles count from qpos0 (the model's zero pose), so the start pose is set in the data,
-        // not in the model; free joints (hand, object) start from their qpos0 set in SceneModel::build.
-        if let (Some(acts), Some(adrs)) = (shared.ids.arm_act, shared.ids.arm_qpos) {
+        // not in the model; the object's free joint starts from its qpos0 set in SceneModel::build.
+        for k in 0..6 {
+            data.qpos_mut()[shared.ids.arm_qpos[k]] = q0[k];
+        }
+        if let Some(acts) = shared.ids.arm_act {
             for k in 0..6 {
                 data.ctrl_mut()[acts[k]] = q0[k];
-                data.qpos_mut()[adrs[k]] = q0[k];
             }
         }
         data.forward();
@@ -322,16 +326,16 @@ impl Scene {
             let ctrl = &mut self.data.ctrl_mut()[act];
             *ctrl += (target - *ctrl).clamp(-max, max);
         }
-        if let Some(mocap) = self.shared.ids.mocap {
-            let max = self.shared.spec.physics.arm_max_speed_rad_s * self.timestep();
+        if self.shared.ids.arm_act.is_none() {
+            // Prescribed motion: this step's start angles and the velocity that reaches the next ones.
+            let dt = self.timestep();
+            let max = self.shared.spec.physics.arm_max_speed_rad_s * dt;
             for k in 0..6 {
-                self.arm_q[k] += (self.arm_target[k] - self.arm_q[k]).clamp(-max, max);
+                let step = (self.arm_target[k] - self.arm_q[k]).clamp(-max, max);
+                self.data.qpos_mut()[ids.arm_qpos[k]] = self.arm_q[k];
+                self.data.qvel_mut()[ids.arm_dof[k]] = step / dt;
+                self.arm_q[k] += step;
             }
-            let pose = ur5e::forward(&self.arm_q);
-            let q = pose.rotation.quaternion();
-            let p = pose.translation.vector;
-            self.data.mocap_pos_mut()[mocap] = [p.x, p.y, p.z];
-            self.data.mocap_quat_mut()[mocap] = [q.w, q.i, q.j, q.k];
         }
         self.data.step();
         self.check(t0 + self.timestep())
@@ -375,7 +379,13 @@ impl Scene {
                 });
             }
         }
-        let kinetic = self.data.energy()[1];
+        // Kinetic energy of what is simulated: the kinematic arm's armature term is prescribed motion.
+        let mut kinetic = self.data.energy()[1];
+        if self.shared.ids.arm_act.is_none() {
+            for d in self.shared.ids.arm_dof {
+                kinetic -= 0.5 * KINEMATIC_ARM_ARMATURE * self.data.qvel()[d].powi(2);
+            }
+        }
         if !kinetic.is_finite() || kinetic > self.shared.spec.physics.max_kinetic_energy_j {
             return diverged(Divergence::Energy { joules: kinetic });
         }
@@ -426,8 +436,8 @@ impl Scene {
             twine_setpoint_m: self.data.ctrl()[ids.twine_act],
             creep_m: qpos[ids.creep_qpos],
             tendon_tension_n: self.tendon_tension_n(),
-            arm_q: match ids.arm_qpos {
-                Some(adr) => adr.map(|a| qpos[a]),
+            arm_q: match ids.arm_act {
+                Some(_) => ids.arm_qpos.map(|a| qpos[a]),
                 None => self.arm_q,
             },
             ..PhysicsReadout::default()
