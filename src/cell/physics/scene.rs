@@ -248,12 +248,12 @@ impl Scene {
         let q0 = shared.spec.arm_q0;
         // Hinge angles count from qpos0 (the model's zero pose), so the start pose is set in the data,
         // not in the model; the object's free joint starts from its qpos0 set in SceneModel::build.
-        for k in 0..6 {
-            data.qpos_mut()[shared.ids.arm_qpos[k]] = q0[k];
+        for (adr, q) in shared.ids.arm_qpos.iter().zip(q0) {
+            data.qpos_mut()[*adr] = q;
         }
         if let Some(acts) = shared.ids.arm_act {
-            for k in 0..6 {
-                data.ctrl_mut()[acts[k]] = q0[k];
+            for (a, q) in acts.iter().zip(q0) {
+                data.ctrl_mut()[*a] = q;
             }
         }
         data.forward();
