@@ -25,8 +25,10 @@ pub struct CheckScenario {
 pub struct CheckScript {
     /// Growth commanded at t = 0 [m].
     pub growth_m: f64,
-    /// Twine ramped in linearly over 1 s once the strip is grown [m].
+    /// Twine wound in once the strip is grown [m].
     pub twine_m: f64,
+    /// Winding speed of that ramp [m/s] (a steady wrap; full motor speed flings the strip's tip).
+    pub wind_speed_m_s: f64,
     /// Hold before lifting [s].
     pub hold_s: f64,
     /// Lift height of the hand after the hold [m] (straight up, joint targets by inverse kinematics).
@@ -49,6 +51,7 @@ impl Default for CheckScript {
         CheckScript {
             growth_m: 0.14,
             twine_m: 0.03,
+            wind_speed_m_s: 0.0075,
             hold_s: 3.0,
             lift_m: 0.1,
             lift_duration_s: 2.0,
@@ -67,6 +70,7 @@ impl Validate for CheckScenario {
         at.section("object", &self.object);
         at.non_negative("check.growth_m", self.check.growth_m);
         at.non_negative("check.twine_m", self.check.twine_m);
+        at.positive("check.wind_speed_m_s", self.check.wind_speed_m_s);
         at.non_negative("check.hold_s", self.check.hold_s);
         at.finite("check.lift_m", self.check.lift_m);
         at.positive("check.lift_duration_s", self.check.lift_duration_s);
@@ -89,7 +93,8 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     let c = &s.check;
     // Growth runs at the motor's speed; the twine ramp starts 0.5 s after it is done.
     let t_twine = c.growth_m / s.finger.motor_max_speed_m_s + 0.5;
-    let t_lift = t_twine + 1.0 + c.hold_s;
+    let t_wind = c.twine_m / c.wind_speed_m_s;
+    let t_lift = t_twine + t_wind + c.hold_s;
     let end = t_lift + c.after_lift_s;
     let every = (c.print_every_s / scene.timestep()).round().max(1.0) as usize;
     println!("t_s pad_N grip_N contacts twine_m creep_m tension_N obj_in_hand_z_mm slip_mm_s hand_z_m");
@@ -101,11 +106,11 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     let mut twine = 0.0;
     while scene.time() < end {
         let t = scene.time();
-        if c.pad_setpoint_n > 0.0 && t > t_twine + 1.0 {
+        if c.pad_setpoint_n > 0.0 && t > t_twine + t_wind {
             let error = c.pad_setpoint_n - scene.readout().pad_force_n;
             twine += c.loop_gain_m_per_n_s * error * scene.timestep();
         } else {
-            twine = c.twine_m * (t - t_twine).clamp(0.0, 1.0);
+            twine = c.twine_m * ((t - t_twine) / t_wind).clamp(0.0, 1.0);
         }
         scene.set_twine(twine)?;
         if t >= t_lift {
