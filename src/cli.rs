@@ -41,6 +41,14 @@ enum Command {
         #[arg(long = "set")]
         set: Vec<String>,
     },
+    /// Build the physics scene from a scenario and run a scripted grasp, printing the readout.
+    PhysicsCheck {
+        /// Scenario TOML with optional [physics], [finger], [object], [check] sections.
+        scenario: Option<std::path::PathBuf>,
+        /// Overrides `key=value`, e.g. `finger.relaxation_time_s=8`.
+        #[arg(long = "set")]
+        set: Vec<crate::scenario::Override>,
+    },
 }
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
@@ -81,6 +89,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 }
                 None => print!("{csv}"),
             }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::PhysicsCheck { scenario, set } => {
+            let s: crate::cell::physics::check::CheckScenario = match scenario {
+                Some(path) => crate::scenario::load(&path, &set)?,
+                None => crate::scenario::from_str("", std::path::Path::new("(defaults)"), &set)?,
+            };
+            crate::cell::physics::check::run(&s)?;
             Ok(ExitCode::SUCCESS)
         }
     }

@@ -1,0 +1,90 @@
+//! Simulation speed of the physics scenes, reported as time per simulated second: the real-time factor
+//! is 1 / (that time in seconds). `cargo bench --bench physics`.
+//!
+//! - `full_scene_kinematic_1s`: the pick-and-place scene with default settings (kinematic arm, 10-segment
+//!   finger with the pad, crimper, table), already grasped, lifting the hand 5 cm in the measured second.
+//! - `full_scene_dynamic_arm_1s`: the same with the six-joint arm dynamics.
+//! - `minimal_box_on_plane_1s`: a box resting on a plane with the same options.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+use tendril::cell::physics::{ArmMode, PhysicsConfig, Scene, SceneSpec, ur5e, validation};
+
+/// A scene already holding the object: grown (3.5 s at the motor's speed), twined to 32 mm (1 s),
+/// settled (0.5 s).
+fn grasped(spec: &SceneSpec) -> Scene {
+    let mut s = Scene::build(spec).expect("scene builds");
+    s.set_growth(spec.finger.length_m).unwrap();
+    s.run_for(3.5).unwrap();
+    let n = (1.0 / s.timestep()).round() as usize;
+    for k in 1..=n {
+        s.set_twine(0.032 * k as f64 / n as f64).unwrap();
+        s.step().unwrap();
+    }
+    s.run_for(0.5).unwrap();
+    assert!(s.readout().grip_contacts > 0, "bench scene must be grasping");
+    s
+}
+
+/// Joint targets lifting the hand 5 cm in one second (computed outside the timing).
+fn lift_targets(steps: usize) -> Vec<[f64; 6]> {
+    let start = ur5e::forward(&ur5e::HOME);
+    let mut seed = ur5e::HOME;
+    (1..=steps)
+        .map(|k| {
+            let mut t = start;
+            t.translation.vector.z += 0.05 * k as f64 / steps as f64;
+            seed = ur5e::inverse_near(&t, &seed).expect("reachable");
+            seed
+        })
+        .collect()
+}
+
+fn bench_scene(c: &mut Criterion, name: &str, spec: SceneSpec) {
+    let steps = (1.0 / spec.physics.timestep_s).round() as usize;
+    let targets = lift_targets(steps);
+    c.bench_function(name, |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                let mut s = grasped(&spec);
+                let t0 = Instant::now();
+                for q in &targets {
+                    s.set_arm_target(*q).unwrap();
+                    s.step().unwrap();
+                }
+                total += t0.elapsed();
+                black_box(s.readout());
+            }
+            total
+        })
+    });
+}
+
+fn physics(c: &mut Criterion) {
+    bench_scene(c, "full_scene_kinematic_1s", SceneSpec::default());
+    let mut dynamic = SceneSpec::default();
+    dynamic.physics.arm_mode = ArmMode::Dynamic;
+    bench_scene(c, "full_scene_dynamic_arm_1s", dynamic);
+
+    let p = PhysicsConfig::default();
+    let model = validation::box_on_plane(&p).expect("builds");
+    let steps = (1.0 / p.timestep_s).round() as usize;
+    c.bench_function("minimal_box_on_plane_1s", |b| {
+        b.iter(|| {
+            let mut d = model.make_data();
+            for _ in 0..steps {
+                d.step();
+            }
+            black_box(d.qpos()[2])
+        })
+    });
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10).measurement_time(Duration::from_secs(3));
+    targets = physics
+}
+criterion_main!(benches);

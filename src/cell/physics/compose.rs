@@ -1,0 +1,206 @@
+//! Assembles a scene's MJCF from the parts in models/ and the scenario's values.
+
+use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig};
+use super::template::{num, nums, render, section};
+use super::{PhysicsError, SceneSpec, ur5e};
+use nalgebra::{Isometry3, Point3, Vector3};
+
+const FINGER: &str = include_str!("../../../models/finger.xml");
+const SEGMENT: &str = include_str!("../../../models/finger_segment.xml");
+const PAD: &str = include_str!("../../../models/sensor_pad.xml");
+const UR5E: &str = include_str!("../../../models/ur5e.xml");
+const TABLE: &str = include_str!("../../../models/table.xml");
+
+/// Height of the pad's bump tip above the casing's base [m]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
+pub const PAD_HEIGHT_M: f64 = 0.0055;
+/// Clearance between the grown, straight strip's bump and the object [m], so growing does not push it.
+pub const GROW_CLEARANCE_M: f64 = 0.001;
+/// Gap between the object and the palm at the start [m]: touching (0.2 mm), so the wrap presses it on
+/// the palm from the start instead of dragging it there part-way through tightening (which shifted the
+/// load off the pad by ~10 %).
+pub const PALM_GAP_M: f64 = 0.0002;
+
+/// A model file without its leading comment (whose prose names the template's fields).
+fn body_of(text: &str) -> &str {
+    text.split_once("-->").map_or(text, |(_, rest)| rest)
+}
+
+/// The `<compiler>`, `<option>` and contact `<default>` every scene (and validation scene) shares.
+/// Energy is computed for the runaway check; constraint islands are off (the cell is one island, and
+/// finding islands cost ~20 % of a step, measured with `perf stat` on `tendril physics-check`).
+pub fn header(p: &PhysicsConfig) -> String {
+    let integrator = match p.integrator {
+        Integrator::Euler => "Euler",
+        Integrator::Rk4 => "RK4",
+        Integrator::Implicit => "implicit",
+        Integrator::Implicitfast => "implicitfast",
+    };
+    let cone = match p.cone {
+        Cone::Pyramidal => "pyramidal",
+        Cone::Elliptic => "elliptic",
+    };
+    format!(
+        r#"<compiler angle="radian" autolimits="true"/>
+  <option timestep="{dt}" integrator="{integrator}" cone="{cone}" impratio="{imp}" solver="Newton"
+          iterations="{it}" tolerance="{tol}" ls_iterations="{ls}" noslip_iterations="{ns}"
+          noslip_tolerance="{nstol}">
+    <flag energy="enable" island="disable"/>
+  </option>
+  <default>
+    <geom solref="{tc} {dr}" solimp="{si} 0.5 2"/>
+  </default>"#,
+        dt = num(p.timestep_s),
+        imp = num(p.impratio),
+        it = p.iterations,
+        tol = num(p.tolerance),
+        ls = p.ls_iterations,
+        ns = p.noslip_iterations,
+        nstol = num(p.noslip_tolerance),
+        tc = num(p.contact_timeconst_s),
+        dr = num(p.contact_dampratio),
+        si = nums(&p.contact_solimp),
+    )
+}
+
+/// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
+/// document whose hand body goes into the arm's flange.
+pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
+    let n = f.segments as usize;
+    let l = f.segment_length_m();
+    let r = f.thickness_m / 2.0;
+    let seg_mass = f.density_kg_m3 * l * f.width_m * f.thickness_m;
+    let pad_seg = ((f.pad_position_m / l).floor() as usize).min(n - 1);
+    let pad_x = f.pad_position_m - pad_seg as f64 * l;
+    // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
+    let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
+    let pad = render(
+        body_of(PAD),
+        &[
+            ("x", num(pad_x)),
+            ("r", num(r)),
+            ("casing_y", num(r + 0.002 + sink)),
+            ("bump_y", num(r + 0.004 + sink)),
+            ("site_y", num(r + 0.005 + sink)),
+        ],
+    )?;
+    let segment_body = body_of(SEGMENT);
+    let mut chain = String::new();
+    for i in (0..n).rev() {
+        chain = render(
+            segment_body,
+            &[
+                ("i", i.to_string()),
+                ("x", num(if i == 0 { 0.0 } else { l })),
+                // Helix: each segment one step towards the flange (-z in the hand frame).
+                ("z", num(if i == 0 { 0.0 } else { -f.helix_slope * l })),
+                ("k_bend", num(f.bending_stiffness_n_m2 / l)),
+                ("d_bend", num(f.joint_damping_n_m_s)),
+                ("a_bend", num(f.joint_armature_kg_m2)),
+                ("max_curl", num(2.0)),
+                ("half_len", num(l / 2.0)),
+                ("half_width", num(f.width_m / 2.0)),
+                ("radius", num(r)),
+                ("mass", num(seg_mass)),
+                ("pad", if i == pad_seg { pad.clone() } else { String::new() }),
+                ("child", chain),
+            ],
+        )?;
+    }
+    let curl_terms: String =
+        (0..n).map(|i| format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(f.moment_arm_m))).collect();
+    let k = f.tendon_stiffness_n_m;
+    let k_elastic = f.relaxed_fraction * k;
+    let k_maxwell = (1.0 - f.relaxed_fraction) * k;
+    // The dashpot's node needs some inertia; 1e-3 kg keeps its own time constant (m / c) far below tau.
+    let creep_damping = f.relaxation_time_s * k_maxwell.max(1e-9);
+    render(
+        body_of(FINGER),
+        &[
+            ("exit_z", num(f.exit_z_m)),
+            ("length", num(f.length_m)),
+            ("moment_arm", num(f.moment_arm_m)),
+            ("segments", chain),
+            ("motor_armature", num(f.motor_armature_kg)),
+            ("twine_range", nums(&[0.0, f.twine_max_m])),
+            ("growth_range", nums(&[0.0, f.length_m])),
+            ("creep_damping", num(creep_damping)),
+            ("creep_armature", num(1e-3)),
+            ("root_x", num(-f.length_m)),
+            ("half_length", num(f.length_m / 2.0)),
+            ("guide_x", num(-f.length_m / 2.0)),
+            ("guide_half_width", num(f.width_m / 2.0 + 0.002 + f.helix_slope * f.length_m)),
+            ("wall_y", num(r + 0.0012)),
+            ("k_elastic", num(k_elastic)),
+            ("k_maxwell", num(k_maxwell)),
+            ("curl_terms", curl_terms),
+            ("motor_kp", num(f.motor_kp_n_m)),
+            ("motor_kv", num(f.motor_kv_n_s_m)),
+        ],
+    )
+}
+
+/// Where the scene's parts stand at the start, in the world frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placement {
+    /// Tool-flange (= hand frame) pose at the start arm configuration.
+    pub hand: Isometry3<f64>,
+    /// Object footprint centre (its body origin) [m]; `None` when the scene has no object.
+    pub object: Option<Vector3<f64>>,
+    /// Height of the table plane [m].
+    pub table_z: f64,
+}
+
+/// Computes the start placement: the hand from forward kinematics of the start joint angles; the
+/// object (unless its position is given) against the palm ([`PALM_GAP_M`]) and so far beside the strip
+/// that the growing strip's pad passes it with [`GROW_CLEARANCE_M`] to spare; the table under
+/// the object so that the strip's plane crosses the middle of the grip.
+pub fn placement(spec: &SceneSpec) -> Placement {
+    let hand = ur5e::forward(&spec.arm_q0);
+    let f = &spec.finger;
+    let Some(obj) = &spec.object else {
+        return Placement { hand, object: None, table_z: 0.0 };
+    };
+    let radius = obj.name.grip_radius_m();
+    let y = f.thickness_m / 2.0 + f.pad_protrusion_m + GROW_CLEARANCE_M + radius;
+    let wrap = hand * Point3::new(radius + PALM_GAP_M, y, f.exit_z_m);
+    let base_z = wrap.z - obj.name.grip_height_m();
+    let (x, y) = match obj.position_m {
+        Some([x, y]) => (x, y),
+        None => (wrap.x, wrap.y),
+    };
+    Placement { hand, object: Some(Vector3::new(x, y, base_z)), table_z: base_z }
+}
+
+/// The full scene MJCF for `spec`, and where its parts start.
+pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
+    let place = placement(spec);
+    let mut worldbody = String::new();
+    let mut actuator = String::new();
+    let mut tendon = String::new();
+    let mut sensor = String::new();
+
+    if spec.object.is_some() {
+        let table = TABLE.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
+        worldbody.push_str(section(&table, "worldbody"));
+        worldbody.push_str(section(spec.object.as_ref().map(|o| o.name.mjcf()).unwrap_or(""), "worldbody"));
+    }
+    // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
+    // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
+    let finger_doc = finger(&spec.finger)?;
+    let arm = render(UR5E, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
+    worldbody.push_str(section(&arm, "worldbody"));
+    if spec.physics.arm_mode == ArmMode::Dynamic {
+        actuator.push_str(section(&arm, "actuator"));
+    }
+    actuator.push_str(section(&finger_doc, "actuator"));
+    tendon.push_str(section(&finger_doc, "tendon"));
+    sensor.push_str(section(&finger_doc, "sensor"));
+
+    let xml = format!(
+        "<mujoco model=\"tendril_cell\">\n  {header}\n  <worldbody>{worldbody}</worldbody>\n  \
+         <tendon>{tendon}</tendon>\n  <actuator>{actuator}</actuator>\n  \
+         <sensor>{sensor}</sensor>\n</mujoco>\n",
+        header = header(&spec.physics),
+    );
+    Ok((xml, place))
+}

@@ -1,0 +1,363 @@
+//! Scenario sections `[physics]`, `[finger]` and `[object]`: every tunable of the MuJoCo scene.
+
+use crate::scenario::{Checker, Validate};
+use serde::Deserialize;
+
+/// MuJoCo's integrator (`<option integrator>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// Semi-implicit Euler (joint damping implicit).
+    Euler,
+    /// 4th-order Runge-Kutta.
+    Rk4,
+    /// Implicit in velocity (full derivatives).
+    Implicit,
+    /// Implicit in velocity, skipping Coriolis derivatives: damping and servo `kv` implicit, cheap.
+    Implicitfast,
+}
+
+/// Friction cone (`<option cone>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Cone {
+    /// Pyramidal approximation: creeps below the friction limit (see modeling.md).
+    Pyramidal,
+    /// Exact Coulomb cone.
+    Elliptic,
+}
+
+/// How the UR5e is simulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ArmMode {
+    /// Prescribed arm motion: each step the six joints are set to the commanded angles (rate-limited
+    /// to `arm_max_speed_rad_s`) with the matching joint velocities, so the hand moves exactly along the
+    /// UR's trajectory and has the velocity friction needs (a mocap body would have none). The joints
+    /// carry a large armature so contact forces do not move the arm within a step. The UR's own servo
+    /// loop is stiff enough that the real hand follows its trajectory too. Cheapest (no servos).
+    Kinematic,
+    /// The six joints with masses, gravity compensation and position servos (models/ur5e.xml).
+    Dynamic,
+}
+
+/// `[physics]`: MuJoCo options and the divergence bounds.
+///
+/// Defaults follow MuJoCo's advice for slip accuracy (elliptic cones, large impratio, Newton solver with
+/// a small tolerance, then noslip iterations; modeling.md measured that pyramidal cones creep and a held
+/// box creeps without noslip) at the largest step that passes tests/physics_validation.rs and keeps the
+/// full scene above 100x real time (benches/physics.rs).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PhysicsConfig {
+    /// Simulation step [s]. 2 ms: contact time constants down to 4 ms stay resolvable (MuJoCo needs
+    /// solref time constant >= 2 steps) and the finger's stiffest mode is resolved.
+    pub timestep_s: f64,
+    /// Integrator. `implicitfast`: the creep dashpot (thousands of N s/m on a 1 g node) and the servos'
+    /// `kv` are integrated implicitly, which explicit Euler would not survive at this step.
+    pub integrator: Integrator,
+    /// Friction cone. `elliptic`: exact Coulomb limit (pyramidal creeps, modeling.md).
+    pub cone: Cone,
+    /// Ratio of frictional to normal constraint impedance. 10: makes friction hard so a held object does
+    /// not creep (MuJoCo docs; modeling.md: slope holds to 26.55 deg with 10).
+    pub impratio: f64,
+    /// Newton solver iterations (upper bound; it usually converges in 2-5).
+    pub iterations: u32,
+    /// Solver tolerance (relative cost improvement). Small so friction is converged.
+    pub tolerance: f64,
+    /// Line-search iterations of the Newton solver.
+    pub ls_iterations: u32,
+    /// Post-solve no-slip iterations. 4: removes the residual tangential creep of soft contacts
+    /// (modeling.md: a held box crept ~1 mm/s until noslip was added).
+    pub noslip_iterations: u32,
+    /// No-slip solver tolerance.
+    pub noslip_tolerance: f64,
+    /// Contact solref time constant [s] (global default): stiffness of contacts. 0.01 s: at least 5 steps
+    /// at the default step (MuJoCo recommends >= 2), stiff enough that the finger sinks < 1 mm.
+    pub contact_timeconst_s: f64,
+    /// Contact solref damping ratio (1 = critical).
+    pub contact_dampratio: f64,
+    /// Contact solimp (d0, dwidth, width [m]): impedance 0.95 -> 0.99 over 1 mm of penetration.
+    pub contact_solimp: [f64; 3],
+    /// Arm simulation mode (`kinematic` | `dynamic`).
+    pub arm_mode: ArmMode,
+    /// Kinematic mode: the largest joint speed the commanded targets are followed with [rad/s]; UR5e
+    /// maximum 180 deg/s (hardware.md). Targets further away are approached at this speed.
+    pub arm_max_speed_rad_s: f64,
+    /// Divergence bound: deepest allowed contact penetration [m]. A finger 5 mm inside an object is not
+    /// a soft contact any more but a blown-up one.
+    pub max_penetration_m: f64,
+    /// Divergence bound: largest allowed kinetic energy of the scene [J]. The cell's moving parts hold
+    /// < 5 J at UR5e speeds (20 kg arm at 0.5 m/s); 200 J means runaway.
+    pub max_kinetic_energy_j: f64,
+}
+
+impl Default for PhysicsConfig {
+    fn default() -> Self {
+        PhysicsConfig {
+            timestep_s: 0.005,
+            integrator: Integrator::Implicitfast,
+            cone: Cone::Elliptic,
+            impratio: 10.0,
+            iterations: 50,
+            tolerance: 1e-8,
+            ls_iterations: 20,
+            noslip_iterations: 10,
+            noslip_tolerance: 1e-8,
+            contact_timeconst_s: 0.01,
+            contact_dampratio: 1.0,
+            contact_solimp: [0.95, 0.99, 0.001],
+            arm_mode: ArmMode::Kinematic,
+            arm_max_speed_rad_s: std::f64::consts::PI,
+            max_penetration_m: 0.005,
+            max_kinetic_energy_j: 200.0,
+        }
+    }
+}
+
+impl Validate for PhysicsConfig {
+    fn validate(&self, at: &mut Checker) {
+        at.in_range("timestep_s", self.timestep_s, 1e-5, 0.05);
+        at.in_range("impratio", self.impratio, 1.0, 1000.0);
+        at.require("iterations", self.iterations >= 1, || "must be >= 1".into());
+        at.positive("tolerance", self.tolerance);
+        at.require("ls_iterations", self.ls_iterations >= 1, || "must be >= 1".into());
+        at.non_negative("noslip_tolerance", self.noslip_tolerance);
+        at.positive("contact_timeconst_s", self.contact_timeconst_s);
+        at.positive("contact_dampratio", self.contact_dampratio);
+        let [d0, dw, w] = self.contact_solimp;
+        at.require("contact_solimp", (0.0..1.0).contains(&d0) && (d0..1.0).contains(&dw) && w > 0.0, || {
+            format!("needs 0 <= d0 <= dwidth < 1 and width > 0, got {:?}", self.contact_solimp)
+        });
+        at.positive("arm_max_speed_rad_s", self.arm_max_speed_rad_s);
+        at.positive("max_penetration_m", self.max_penetration_m);
+        at.positive("max_kinetic_energy_j", self.max_kinetic_energy_j);
+    }
+}
+
+/// `[finger]`: the grow-and-twine finger's physical parameters (models/finger.xml is the template).
+///
+/// Nothing about the real finger's dimensions is published (modeling.md); the values are plausible
+/// choices for a flat TPU strip with a tendon, stated here, and the viscoelastic ones are meant to be
+/// tuned so the twin reproduces the paper's slip times without feedback (crimper ~10 s, shampoo ~13 s,
+/// hammer ~17 s after the arm starts moving).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FingerConfig {
+    /// Number of strip segments (discretisation). 10: 14 mm segments, a 12 mm pad fits on one and a
+    /// 12.5 mm-radius handle is wrapped by ~6 segments.
+    pub segments: u32,
+    /// Strip length that can be grown out of the guide [m]; paper Sec. V grows 14.0 cm.
+    pub length_m: f64,
+    /// Strip thickness [m] (capsule diameter). 2 mm: a choice for a TPU strip with a tendon channel.
+    pub thickness_m: f64,
+    /// Strip width [m] (mass only; the capsules touch along a line). 20 mm, from the photos' proportions.
+    pub width_m: f64,
+    /// Strip density [kg/m^3]. TPU 1200 (typical datasheet value).
+    pub density_kg_m3: f64,
+    /// Bending stiffness EI of the strip [N m^2]; each joint gets EI / segment length [N m/rad].
+    /// 2e-4: TPU (E ~ 30 MPa) 20 mm x 2 mm strip gives 4e-4; halved for the tendon channel. Tunable.
+    pub bending_stiffness_n_m2: f64,
+    /// Bending damping per joint [N m s/rad]; a choice that damps the strip's free flapping in ~0.1 s.
+    pub joint_damping_n_m_s: f64,
+    /// Inertia added to each bending joint [kg m^2]. Numerical, not physical: MuJoCo's soft contacts are
+    /// as stiff as the effective mass behind them, and a 1 g segment sank up to 12 mm into the objects
+    /// (and tunnelled through the shampoo) at 5 ms; 1e-4 keeps penetration near 1 mm in every grasp tried
+    /// (modeling.md saw the same fix). Side effect: the strip's own curl mode has a period of ~0.6 s,
+    /// still much faster than the paper's 5 s force loop; it does not add inertia to the object.
+    pub joint_armature_kg_m2: f64,
+    /// Tendon offset from the strip's neutral axis [m] (moment arm of the tendon on each joint). 3 mm.
+    pub moment_arm_m: f64,
+    /// Instantaneous tendon-path stiffness K [N/m] (both SLS branches in parallel): tendon plus the soft
+    /// material it pulls on. Tunable; sets how fast grip grows with twine.
+    pub tendon_stiffness_n_m: f64,
+    /// Relaxed fraction f of the standard linear solid: after creep the stiffness is f K. Tunable.
+    pub relaxed_fraction: f64,
+    /// Relaxation time tau [s] of the standard linear solid (dashpot c = tau (1 - f) K). Tunable.
+    pub relaxation_time_s: f64,
+    /// Equivalent translating inertia of each MX-106 at its output [kg] (joint armature). A choice.
+    pub motor_armature_kg: f64,
+    /// Position-servo stiffness of both motors [N/m]. A choice: 1 mm error -> 20 N.
+    pub motor_kp_n_m: f64,
+    /// Position-servo damping of both motors [N s/m]; near critical for the armature.
+    pub motor_kv_n_s_m: f64,
+    /// Largest speed of either motor's output [m/s]: commands further away are approached at this
+    /// speed. MX-106 no-load speed 45 rpm at 12 V (hardware.md) on the 10 mm spool = 0.047 m/s.
+    pub motor_max_speed_m_s: f64,
+    /// Largest twine (tendon wound in) [m].
+    pub twine_max_m: f64,
+    /// Distance of the sensor pad's centre from the strip's base [m] (on the sleeve, near the guide,
+    /// paper Sec. V). 43.75 mm: inside the wrap of a 12-14 mm radius handle or neck, and the middle of
+    /// the third of 8 segments: a flat segment touches a round handle at its middle, so a pad there is
+    /// loaded steadily (a pad over a joint was loaded erratically). Keep it mid-segment when changing
+    /// `segments`.
+    pub pad_position_m: f64,
+    /// Rise of the strip per metre along it (dimensionless): the real strip twines as a helix, so its
+    /// second turn lies above the first instead of wedging between the first turn and the object.
+    /// Modelled as a step of `helix_slope * segment length` between segments (towards the flange).
+    /// 0.27: one turn around a 13 mm radius handle (82 mm of strip) rises by the strip's width plus 2 mm.
+    pub helix_slope: f64,
+    /// Height of the pad's bump tip above the strip's inner face [m]. The casing is 4 mm tall and the
+    /// bump 1.5 mm (5.5 mm in all) but how deep the casing sits in the sleeve is not published: this sets
+    /// how much of the wrap's force the pad takes. Tunable; 2.5 mm (casing 3 mm recessed) gives the pad
+    /// ~20-25 % of the strip's normal force (5.5 mm: 30-45 %). The paper's setpoints (0.6-1.6 N on the
+    /// pad for objects needing 4-8 N of normal force at their friction) suggest 10-20 %.
+    pub pad_protrusion_m: f64,
+    /// Distance below the flange at which the strip leaves the guide [m] (hand length). A choice.
+    pub exit_z_m: f64,
+}
+
+impl Default for FingerConfig {
+    fn default() -> Self {
+        FingerConfig {
+            segments: 8,
+            length_m: 0.14,
+            thickness_m: 0.002,
+            width_m: 0.02,
+            density_kg_m3: 1200.0,
+            bending_stiffness_n_m2: 2e-4,
+            joint_damping_n_m_s: 2e-4,
+            joint_armature_kg_m2: 1e-4,
+            moment_arm_m: 0.003,
+            tendon_stiffness_n_m: 2000.0,
+            relaxed_fraction: 0.5,
+            relaxation_time_s: 5.0,
+            motor_armature_kg: 2.0,
+            motor_kp_n_m: 20000.0,
+            motor_kv_n_s_m: 400.0,
+            motor_max_speed_m_s: 0.047,
+            twine_max_m: 0.06,
+            pad_position_m: 0.04375,
+            pad_protrusion_m: 0.0025,
+            helix_slope: 0.27,
+            exit_z_m: 0.1,
+        }
+    }
+}
+
+impl FingerConfig {
+    /// Length of one segment [m].
+    pub fn segment_length_m(&self) -> f64 {
+        self.length_m / f64::from(self.segments.max(1))
+    }
+}
+
+impl Validate for FingerConfig {
+    fn validate(&self, at: &mut Checker) {
+        at.require("segments", (2..=60).contains(&self.segments), || {
+            format!("must be between 2 and 60, got {}", self.segments)
+        });
+        at.in_range("length_m", self.length_m, 0.02, 0.5);
+        at.in_range("thickness_m", self.thickness_m, 2e-4, 0.02);
+        at.positive("width_m", self.width_m);
+        at.positive("density_kg_m3", self.density_kg_m3);
+        at.non_negative("bending_stiffness_n_m2", self.bending_stiffness_n_m2);
+        at.non_negative("joint_damping_n_m_s", self.joint_damping_n_m_s);
+        at.non_negative("joint_armature_kg_m2", self.joint_armature_kg_m2);
+        at.positive("moment_arm_m", self.moment_arm_m);
+        at.positive("tendon_stiffness_n_m", self.tendon_stiffness_n_m);
+        at.in_range("relaxed_fraction", self.relaxed_fraction, 0.0, 1.0);
+        at.positive("relaxation_time_s", self.relaxation_time_s);
+        at.positive("motor_armature_kg", self.motor_armature_kg);
+        at.positive("motor_kp_n_m", self.motor_kp_n_m);
+        at.non_negative("motor_kv_n_s_m", self.motor_kv_n_s_m);
+        at.positive("motor_max_speed_m_s", self.motor_max_speed_m_s);
+        at.positive("twine_max_m", self.twine_max_m);
+        at.require(
+            "pad_position_m",
+            self.pad_position_m > 0.006 && self.pad_position_m < self.length_m - 0.006,
+            || {
+                format!(
+                    "must leave the 12 mm pad on the strip (0.006 .. length_m - 0.006), got {}",
+                    self.pad_position_m
+                )
+            },
+        );
+        at.in_range("pad_protrusion_m", self.pad_protrusion_m, 0.0005, 0.0055);
+        at.in_range("helix_slope", self.helix_slope, 0.0, 1.0);
+        at.positive("exit_z_m", self.exit_z_m);
+    }
+}
+
+/// Which of the paper's objects the scene holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjectName {
+    /// Crimper with rubber handle, 351 g.
+    Crimper,
+    /// Wooden hammer, 419 g.
+    Hammer,
+    /// Plastic shampoo bottle, 222 g.
+    Shampoo,
+}
+
+impl ObjectName {
+    /// The MJCF text of the object (models/objects/*.xml).
+    pub fn mjcf(self) -> &'static str {
+        match self {
+            ObjectName::Crimper => include_str!("../../../models/objects/crimper.xml"),
+            ObjectName::Hammer => include_str!("../../../models/objects/hammer.xml"),
+            ObjectName::Shampoo => include_str!("../../../models/objects/shampoo.xml"),
+        }
+    }
+
+    /// Mass from the paper (Sec. V) [kg].
+    pub fn paper_mass_kg(self) -> f64 {
+        match self {
+            ObjectName::Crimper => 0.351,
+            ObjectName::Hammer => 0.419,
+            ObjectName::Shampoo => 0.222,
+        }
+    }
+}
+
+/// `[object]`: which object, where it stands, and optional overrides.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ObjectConfig {
+    /// The object (`crimper` | `hammer` | `shampoo`).
+    pub name: ObjectName,
+    /// Sliding friction of the object against the finger, replacing the model's material value.
+    pub friction: Option<f64>,
+    /// Where the object's footprint centre stands on the table, world x and y [m]. `None`: right under
+    /// the gripper's wrap in the start pose (the scene starts at the grasp).
+    pub position_m: Option<[f64; 2]>,
+}
+
+impl Default for ObjectConfig {
+    fn default() -> Self {
+        ObjectConfig { name: ObjectName::Crimper, friction: None, position_m: None }
+    }
+}
+
+impl Validate for ObjectConfig {
+    fn validate(&self, at: &mut Checker) {
+        if let Some(mu) = self.friction {
+            at.in_range("friction", mu, 0.0, 5.0);
+        }
+        if let Some([x, y]) = self.position_m {
+            at.finite("position_m", x + y);
+        }
+    }
+}
+
+impl ObjectName {
+    /// Radius of the grip capsule the finger wraps [m] (models/objects/*.xml, `object_grip`).
+    pub fn grip_radius_m(self) -> f64 {
+        match self {
+            ObjectName::Crimper => 0.0125,
+            ObjectName::Hammer => 0.014,
+            ObjectName::Shampoo => 0.012,
+        }
+    }
+
+    /// Height above the object's footprint at which the strip leaves the guide and starts its first
+    /// turn [m]; the helix rises from there, along the grip capsule (models/objects/*.xml).
+    pub fn grip_height_m(self) -> f64 {
+        match self {
+            ObjectName::Crimper => 0.1,
+            ObjectName::Hammer => 0.13,
+            ObjectName::Shampoo => 0.162,
+        }
+    }
+}

@@ -1,0 +1,494 @@
+//! One simulation run of the cell: a compiled, shareable [`SceneModel`] and per-run [`Scene`] state.
+
+use super::compose::{self, Placement};
+use super::config::ArmMode;
+use super::{Divergence, PhysicsError, SceneSpec};
+use crate::scenario::{Checker, Validate};
+use mujoco_rs::mujoco_c::{_mjtObjBase, mjtWarning};
+use mujoco_rs::prelude::{MjData, MjModel};
+use nalgebra::{Isometry3, Point3, Vector3};
+use std::sync::Arc;
+
+/// A compiled scene model and the element ids the readout needs. Build it once and share it (it is
+/// `Send + Sync`) between many [`Scene`]s, for example across threads.
+#[derive(Debug)]
+pub struct SceneModel {
+    model: Arc<MjModel>,
+    spec: SceneSpec,
+    placement: Placement,
+    xml: String,
+    ids: Ids,
+}
+
+#[derive(Debug, Clone)]
+struct Ids {
+    /// Geoms of the sensor pad (casing, bump).
+    pad_geoms: Vec<usize>,
+    /// Geoms of the strip and the pad.
+    finger_geoms: Vec<usize>,
+    /// The palm beside the guide exit.
+    palm_geom: Vec<usize>,
+    /// The object's geoms (empty without object).
+    object_geoms: Vec<usize>,
+    object_body: Option<usize>,
+    object_grip: Option<usize>,
+    object_qpos: Option<usize>,
+    hand_body: usize,
+    growth_qpos: usize,
+    twine_qpos: usize,
+    creep_qpos: usize,
+    growth_act: usize,
+    twine_act: usize,
+    arm_qpos: [usize; 6],
+    arm_dof: [usize; 6],
+    /// Servo actuators of the arm (dynamic mode only).
+    arm_act: Option<[usize; 6]>,
+    tendon_elastic: usize,
+    tendon_maxwell: usize,
+    pad_touch_adr: usize,
+}
+
+fn id(model: &MjModel, kind: _mjtObjBase, kind_name: &'static str, name: &str) -> Result<usize, PhysicsError> {
+    model.name_to_id(kind, name).ok_or_else(|| PhysicsError::Missing { kind: kind_name, name: name.to_string() })
+}
+
+impl SceneModel {
+    /// Validates `spec`, assembles the MJCF from models/, compiles it and applies the overrides that
+    /// edit the compiled model (object friction, start poses).
+    pub fn build(spec: &SceneSpec) -> Result<Arc<SceneModel>, PhysicsError> {
+        let mut checker = Checker::default();
+        spec.validate(&mut checker);
+        if let Some((key, reason)) = checker.into_first_error() {
+            return Err(PhysicsError::Config { key, reason });
+        }
+        let (xml, placement) = compose::scene(spec)?;
+        let mut model =
+            MjModel::from_xml_string(&xml).map_err(|e| PhysicsError::Compile { message: format!("{e:?}") })?;
+        let ids = Self::find_ids(&model, spec)?;
+
+        // Object: material friction override on every object geom, start pose on the table.
+        if let Some(obj) = &spec.object {
+            if let Some(mu) = obj.friction {
+                for &g in &ids.object_geoms {
+                    model.geom_friction_mut()[g][0] = mu;
+                }
+            }
+            if let (Some(adr), Some(p)) = (ids.object_qpos, placement.object) {
+                model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, 1.0, 0.0, 0.0, 0.0]);
+            }
+        }
+        if spec.physics.arm_mode == ArmMode::Kinematic {
+            // Prescribed motion: the arm must not give way to contact forces within a step.
+            for d in ids.arm_dof {
+                model.dof_armature_mut()[d] = KINEMATIC_ARM_ARMATURE;
+            }
+        }
+        Ok(Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids }))
+    }
+
+    fn find_ids(m: &MjModel, spec: &SceneSpec) -> Result<Ids, PhysicsError> {
+        use _mjtObjBase::*;
+        let geom = |n: &str| id(m, mjOBJ_GEOM, "geom", n);
+        let joint = |n: &str| id(m, mjOBJ_JOINT, "joint", n);
+        let qpos = |n: &str| joint(n).map(|j| m.jnt_qposadr()[j] as usize);
+        let act = |n: &str| id(m, mjOBJ_ACTUATOR, "actuator", n);
+        let pad_geoms = vec![geom("pad_casing")?, geom("pad_bump")?];
+        let mut finger_geoms = pad_geoms.clone();
+        for i in 0..spec.finger.segments {
+            finger_geoms.push(geom(&format!("seg{i}"))?);
+        }
+        let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() {
+            let body = id(m, mjOBJ_BODY, "body", "object")?;
+            let geoms = (0..m.ffi().ngeom as usize).filter(|&g| m.geom_bodyid()[g] as usize == body).collect();
+            (geoms, Some(body), Some(geom("object_grip")?), Some(qpos("object")?))
+        } else {
+            (Vec::new(), None, None, None)
+        };
+        let names = ["shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"];
+        let mut arm_qpos = [0; 6];
+        let mut arm_dof = [0; 6];
+        for k in 0..6 {
+            arm_qpos[k] = qpos(names[k])?;
+            arm_dof[k] = m.jnt_dofadr()[joint(names[k])?] as usize;
+        }
+        let arm_act = match spec.physics.arm_mode {
+            ArmMode::Kinematic => None,
+            ArmMode::Dynamic => {
+                let mut a = [0; 6];
+                for k in 0..6 {
+                    a[k] = act(names[k])?;
+                }
+                Some(a)
+            }
+        };
+        let touch = id(m, mjOBJ_SENSOR, "sensor", "pad_touch")?;
+        Ok(Ids {
+            pad_geoms,
+            finger_geoms,
+            palm_geom: vec![geom("palm")?],
+            object_geoms,
+            object_body,
+            object_grip,
+            object_qpos,
+            hand_body: id(m, mjOBJ_BODY, "body", "hand")?,
+            growth_qpos: qpos("growth")?,
+            twine_qpos: qpos("twine")?,
+            creep_qpos: qpos("creep")?,
+            growth_act: act("growth")?,
+            twine_act: act("twine")?,
+            arm_qpos,
+            arm_dof,
+            arm_act,
+            tendon_elastic: id(m, mjOBJ_TENDON, "tendon", "tendon_elastic")?,
+            tendon_maxwell: id(m, mjOBJ_TENDON, "tendon", "tendon_maxwell")?,
+            pad_touch_adr: m.sensor_adr()[touch] as usize,
+        })
+    }
+
+    /// The compiled MuJoCo model.
+    pub fn model(&self) -> &Arc<MjModel> {
+        &self.model
+    }
+
+    /// The spec it was built from.
+    pub fn spec(&self) -> &SceneSpec {
+        &self.spec
+    }
+
+    /// Where the parts start (hand pose, object footprint, table height).
+    pub fn placement(&self) -> &Placement {
+        &self.placement
+    }
+
+    /// The assembled MJCF text (for inspection or saving).
+    pub fn xml(&self) -> &str {
+        &self.xml
+    }
+}
+
+/// What the physics reports after a step (SI units, world frame).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PhysicsReadout {
+    /// Simulated time [s].
+    pub time_s: f64,
+    /// Normal force of the object on the sensor pad (casing and bump) [N]: the FBG sensor's input.
+    pub pad_force_n: f64,
+    /// Sum of the normal forces between the object and the whole finger, pad included [N].
+    pub grip_force_n: f64,
+    /// Normal force between the object and the palm beside the guide exit [N] (not part of the grip
+    /// force: the palm is the hand, not the finger).
+    pub palm_force_n: f64,
+    /// Number of active object-finger contacts.
+    pub grip_contacts: usize,
+    /// Whether the object touches the finger at all.
+    pub touching: bool,
+    /// Object body origin (footprint centre) [m].
+    pub object_pos_m: [f64; 3],
+    /// Object orientation (w, x, y, z).
+    pub object_quat: [f64; 4],
+    /// Linear velocity of the object's grip centre (the middle of the wrapped handle or neck) [m/s].
+    pub object_vel_m_s: [f64; 3],
+    /// The object's grip centre expressed in the hand frame [m]: its change is the slip distance (hand z
+    /// points down in the pick pose, so a falling object's z grows).
+    pub object_in_hand_m: [f64; 3],
+    /// Speed of the object's grip centre relative to the hand point it coincides with [m/s].
+    pub slip_speed_m_s: f64,
+    /// Hand (flange) position [m].
+    pub hand_pos_m: [f64; 3],
+    /// Finger growth out of the guide [m] (actual motor position).
+    pub growth_m: f64,
+    /// Tendon wound in by the twine motor [m] (actual motor position).
+    pub twine_m: f64,
+    /// The twine servo's current setpoint [m] (the command after the motor speed limit).
+    pub twine_setpoint_m: f64,
+    /// Creep elongation of the Maxwell branch [m].
+    pub creep_m: f64,
+    /// Tendon tension, both branches [N].
+    pub tendon_tension_n: f64,
+    /// Arm joint angles [rad] (kinematic mode: the rate-limited commanded angles).
+    pub arm_q: [f64; 6],
+}
+
+/// One simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a bit-identical
+/// trajectory.
+#[derive(Debug)]
+pub struct Scene {
+    shared: Arc<SceneModel>,
+    data: MjData<Arc<MjModel>>,
+    arm_target: [f64; 6],
+    arm_q: [f64; 6],
+    /// Commanded growth and twine [m]; the servo setpoints move towards them at the motor speed.
+    motor_target: [f64; 2],
+    warnings_seen: [i32; 8],
+}
+
+/// Armature of the arm joints in the kinematic mode [kg m^2]: large enough that a few newtons of
+/// contact force do not turn a joint within a step (their motion is prescribed anyway).
+const KINEMATIC_ARM_ARMATURE: f64 = 1000.0;
+
+/// MuJoCo warnings that mean the run is not trustworthy.
+const FATAL_WARNINGS: [(mjtWarning, &str); 6] = [
+    (mjtWarning::mjWARN_INERTIA, "bad inertia"),
+    (mjtWarning::mjWARN_CONTACTFULL, "contact buffer full"),
+    (mjtWarning::mjWARN_CNSTRFULL, "constraint buffer full"),
+    (mjtWarning::mjWARN_BADQPOS, "bad qpos (NaN/Inf/huge)"),
+    (mjtWarning::mjWARN_BADQVEL, "bad qvel (NaN/Inf/huge)"),
+    (mjtWarning::mjWARN_BADQACC, "bad qacc (NaN/Inf/huge): unstable"),
+];
+
+impl Scene {
+    /// Builds the model for `spec` and a run on it.
+    pub fn build(spec: &SceneSpec) -> Result<Scene, PhysicsError> {
+        Ok(Scene::new(SceneModel::build(spec)?))
+    }
+
+    /// A fresh run on a shared model, at the start placement with the finger retracted and slack.
+    pub fn new(shared: Arc<SceneModel>) -> Scene {
+        let mut data = MjData::new(shared.model.clone());
+        let q0 = shared.spec.arm_q0;
+        // Hinge angles count from qpos0 (the model's zero pose), so the start pose is set in the data,
+        // not in the model; the object's free joint starts from its qpos0 set in SceneModel::build.
+        for (adr, q) in shared.ids.arm_qpos.iter().zip(q0) {
+            data.qpos_mut()[*adr] = q;
+        }
+        if let Some(acts) = shared.ids.arm_act {
+            for (a, q) in acts.iter().zip(q0) {
+                data.ctrl_mut()[*a] = q;
+            }
+        }
+        data.forward();
+        Scene { shared, data, arm_target: q0, arm_q: q0, motor_target: [0.0; 2], warnings_seen: [0; 8] }
+    }
+
+    /// The shared model.
+    pub fn shared(&self) -> &Arc<SceneModel> {
+        &self.shared
+    }
+
+    /// Raw MuJoCo data (read-only), for checks beyond the readout.
+    pub fn data(&self) -> &MjData<Arc<MjModel>> {
+        &self.data
+    }
+
+    /// Simulated time [s].
+    pub fn time(&self) -> f64 {
+        self.data.time()
+    }
+
+    /// Step size [s].
+    pub fn timestep(&self) -> f64 {
+        self.shared.spec.physics.timestep_s
+    }
+
+    /// Commands the finger growth (strip length out of the guide) [m], clamped to 0..finger.length_m.
+    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
+    pub fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
+        if !growth_m.is_finite() {
+            return Err(PhysicsError::BadInput { what: "growth", value: growth_m });
+        }
+        self.motor_target[0] = growth_m.clamp(0.0, self.shared.spec.finger.length_m);
+        Ok(())
+    }
+
+    /// Commands the twine motor: metres of tendon wound in (the twining/curl input, the PID's output),
+    /// clamped to 0..finger.twine_max_m. More twine curls the strip tighter and raises the grip force.
+    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
+    pub fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError> {
+        if !twine_m.is_finite() {
+            return Err(PhysicsError::BadInput { what: "twine", value: twine_m });
+        }
+        self.motor_target[1] = twine_m.clamp(0.0, self.shared.spec.finger.twine_max_m);
+        Ok(())
+    }
+
+    /// Commands the arm joint targets [rad]. Dynamic mode: the position servos' setpoints. Kinematic
+    /// mode: the arm moves towards them at most at `physics.arm_max_speed_rad_s` per joint, and the hand
+    /// follows the flange pose from forward kinematics.
+    pub fn set_arm_target(&mut self, q: [f64; 6]) -> Result<(), PhysicsError> {
+        if let Some(v) = q.iter().find(|v| !v.is_finite()) {
+            return Err(PhysicsError::BadInput { what: "arm target", value: *v });
+        }
+        self.arm_target = q;
+        if let Some(acts) = self.shared.ids.arm_act {
+            for (k, a) in acts.iter().enumerate() {
+                self.data.ctrl_mut()[*a] = q[k];
+            }
+        }
+        Ok(())
+    }
+
+    /// Advances one step; a diverging state is a [`PhysicsError::Diverged`] with the time.
+    pub fn step(&mut self) -> Result<(), PhysicsError> {
+        let t0 = self.data.time();
+        let max = self.shared.spec.finger.motor_max_speed_m_s * self.timestep();
+        let ids = &self.shared.ids;
+        for (act, target) in [(ids.growth_act, self.motor_target[0]), (ids.twine_act, self.motor_target[1])] {
+            let ctrl = &mut self.data.ctrl_mut()[act];
+            *ctrl += (target - *ctrl).clamp(-max, max);
+        }
+        if self.shared.ids.arm_act.is_none() {
+            // Prescribed motion: this step's start angles and the velocity that reaches the next ones.
+            let dt = self.timestep();
+            let max = self.shared.spec.physics.arm_max_speed_rad_s * dt;
+            for k in 0..6 {
+                let step = (self.arm_target[k] - self.arm_q[k]).clamp(-max, max);
+                self.data.qpos_mut()[ids.arm_qpos[k]] = self.arm_q[k];
+                self.data.qvel_mut()[ids.arm_dof[k]] = step / dt;
+                self.arm_q[k] += step;
+            }
+        }
+        self.data.step();
+        self.check(t0 + self.timestep())
+    }
+
+    /// Steps for `seconds` of simulated time (rounded to whole steps).
+    pub fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
+        let n = (seconds / self.timestep()).round() as usize;
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    fn check(&mut self, time_s: f64) -> Result<(), PhysicsError> {
+        let diverged = |cause| Err(PhysicsError::Diverged { time_s, cause });
+        // Warnings first: on a bad acceleration MuJoCo resets the state, so the NaN is gone by now.
+        let warnings = self.data.warning();
+        for (k, (w, name)) in FATAL_WARNINGS.iter().enumerate() {
+            let count = warnings[*w as usize].number;
+            if count > self.warnings_seen[k] {
+                self.warnings_seen[k] = count;
+                return diverged(Divergence::Warning { warning: name });
+            }
+        }
+        for (what, values) in [("qpos", self.data.qpos()), ("qvel", self.data.qvel()), ("qacc", self.data.qacc())] {
+            if values.iter().any(|v| !v.is_finite()) {
+                return diverged(Divergence::NonFinite { what });
+            }
+        }
+        let bound = self.shared.spec.physics.max_penetration_m;
+        for c in self.data.contact() {
+            if c.dist < -bound {
+                let name = |g: i32| {
+                    self.shared.model.id_to_name(_mjtObjBase::mjOBJ_GEOM, g as usize).unwrap_or("?").to_string()
+                };
+                return diverged(Divergence::Penetration {
+                    depth_m: -c.dist,
+                    geom1: name(c.geom1),
+                    geom2: name(c.geom2),
+                });
+            }
+        }
+        // Kinetic energy of what is simulated: the kinematic arm's armature term is prescribed motion.
+        let mut kinetic = self.data.energy()[1];
+        if self.shared.ids.arm_act.is_none() {
+            for d in self.shared.ids.arm_dof {
+                kinetic -= 0.5 * KINEMATIC_ARM_ARMATURE * self.data.qvel()[d].powi(2);
+            }
+        }
+        if !kinetic.is_finite() || kinetic > self.shared.spec.physics.max_kinetic_energy_j {
+            return diverged(Divergence::Energy { joules: kinetic });
+        }
+        Ok(())
+    }
+
+    /// Normal force [N] summed over contacts between a geom in `a` and a geom in `b`, and their count.
+    pub fn normal_force_between(&self, a: &[usize], b: &[usize]) -> (f64, usize) {
+        let mut sum = 0.0;
+        let mut n = 0;
+        for (i, c) in self.data.contact().iter().enumerate() {
+            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+            let hit = (a.contains(&g1) && b.contains(&g2)) || (a.contains(&g2) && b.contains(&g1));
+            if hit && c.efc_address >= 0 {
+                sum += self.data.contact_force(i)[0];
+                n += 1;
+            }
+        }
+        (sum, n)
+    }
+
+    /// The pad's normal force as MuJoCo's `touch` sensor on `pad_site` reports it [N].
+    pub fn pad_touch_sensor_n(&self) -> f64 {
+        self.data.sensordata()[self.shared.ids.pad_touch_adr]
+    }
+
+    /// The readout after the last step.
+    pub fn readout(&self) -> PhysicsReadout {
+        let ids = &self.shared.ids;
+        let qpos = self.data.qpos();
+        let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
+        let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
+        let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
+        let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
+        let hq = self.data.xquat()[ids.hand_body];
+        let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
+        let hand = Isometry3::from_parts(hand_p.into(), hand_rot);
+        let mut r = PhysicsReadout {
+            time_s: self.data.time(),
+            pad_force_n,
+            grip_force_n,
+            palm_force_n,
+            grip_contacts,
+            touching: grip_contacts > 0,
+            hand_pos_m: hand_p.into(),
+            growth_m: qpos[ids.growth_qpos],
+            twine_m: qpos[ids.twine_qpos],
+            twine_setpoint_m: self.data.ctrl()[ids.twine_act],
+            creep_m: qpos[ids.creep_qpos],
+            tendon_tension_n: self.tendon_tension_n(),
+            arm_q: match ids.arm_act {
+                Some(_) => ids.arm_qpos.map(|a| qpos[a]),
+                None => self.arm_q,
+            },
+            ..PhysicsReadout::default()
+        };
+        if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {
+            r.object_pos_m = self.data.xpos()[body];
+            r.object_quat = self.data.xquat()[body];
+            let p = Vector3::from(self.data.geom_xpos()[grip]);
+            let vo = self.data.object_velocity(_mjtObjBase::mjOBJ_GEOM, grip, false);
+            let vh = self.data.object_velocity(_mjtObjBase::mjOBJ_BODY, ids.hand_body, false);
+            let v_obj = Vector3::new(vo[3], vo[4], vo[5]);
+            let w_hand = Vector3::new(vh[0], vh[1], vh[2]);
+            let v_hand_at = Vector3::new(vh[3], vh[4], vh[5]) + w_hand.cross(&(p - hand_p));
+            r.object_vel_m_s = v_obj.into();
+            r.slip_speed_m_s = (v_obj - v_hand_at).norm();
+            r.object_in_hand_m = (hand.inverse() * Point3::from(p)).coords.into();
+        }
+        r
+    }
+
+    /// Tension of the tendon path [N]: both standard-linear-solid branches (zero when slack).
+    pub fn tendon_tension_n(&self) -> f64 {
+        let ids = &self.shared.ids;
+        let m = &self.shared.model;
+        let len = self.data.ten_length();
+        let k = m.tendon_stiffness();
+        // Length below the dead band's lower end (0) stretches the tendon.
+        (-len[ids.tendon_elastic]).max(0.0) * k[ids.tendon_elastic]
+            + (-len[ids.tendon_maxwell]).max(0.0) * k[ids.tendon_maxwell]
+    }
+
+    /// Geom ids of the sensor pad (casing, bump).
+    pub fn pad_geoms(&self) -> &[usize] {
+        &self.shared.ids.pad_geoms
+    }
+
+    /// Geom ids of the object.
+    pub fn object_geoms(&self) -> &[usize] {
+        &self.shared.ids.object_geoms
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_can_move_to_other_threads_and_share_the_model() {
+        fn send<T: Send>() {}
+        fn send_sync<T: Send + Sync>() {}
+        send::<Scene>();
+        send_sync::<SceneModel>();
+    }
+}
