@@ -24,6 +24,23 @@ enum Command {
         #[arg(long, default_value = "scenarios")]
         scenarios: std::path::PathBuf,
     },
+    /// Run one pick-and-place scenario on the twin; writes DIR/trace.csv and DIR/summary.json.
+    Run {
+        /// The scenario file (scenarios/crimper.toml, ...).
+        scenario: std::path::PathBuf,
+        /// Output folder [default: out/<scenario name>].
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+        /// Seed of the sensor noise (same scenario and seed: identical trace).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Keep force control on while the arm moves (`on`) or switch it off before (`off`).
+        #[arg(long, value_parser = ["on", "off"])]
+        feedback: Option<String>,
+        /// Override a scenario value: `--set key.path=value` (repeatable), checked like the file.
+        #[arg(long = "set")]
+        set: Vec<crate::scenario::Override>,
+    },
     /// Run the paper's calibration procedures on a bench CSV (columns: time_s, load_cell_n,
     /// fbg1_nm, fbg2_nm, temperature_c) and print the results.
     Calibrate {
@@ -75,6 +92,23 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             }
             Ok(if rows.iter().all(|r| r.pass) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
         }
+        Command::Run { scenario, out, seed, feedback, set } => {
+            let mut overrides = set;
+            if let Some(seed) = seed {
+                overrides
+                    .push(crate::scenario::Override { key: "seed".into(), value: toml::Value::Integer(seed as i64) });
+            }
+            if let Some(f) = feedback {
+                overrides
+                    .push(crate::scenario::Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
+            }
+            let s: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&scenario, &overrides)?;
+            let dir = out.unwrap_or_else(|| std::path::Path::new("out").join(&s.name));
+            let (summary, _) = crate::run::execute::run_on_twin(&s, &Default::default(), Some(&dir))?;
+            print!("{}", crate::run::summary::render_text(&summary));
+            println!("wrote {0}/trace.csv and {0}/summary.json", dir.display());
+            Ok(if summary.outcome == "error" { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+        }
         Command::Calibrate { file } => {
             print!("{}", crate::calibration::report::calibrate_file(&file)?);
             Ok(ExitCode::SUCCESS)
@@ -102,16 +136,16 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// The rows of `tendril reproduce WHAT`: `sensor` (Sec. IV); `all` collects every family
-/// (gripper rows join here when they exist).
+/// The rows of `tendril reproduce WHAT`: `sensor` (Sec. IV), `gripper` (Sec. V) or `all`.
 pub fn reproduce_rows(what: &str, scenario_dir: &std::path::Path) -> anyhow::Result<Vec<crate::reproduce::Row>> {
     match what {
         "sensor" => crate::reproduce::sensor::rows(scenario_dir),
+        "gripper" => crate::reproduce::gripper::rows(scenario_dir, &[]),
         "all" => {
-            let mut rows = Vec::new();
-            rows.extend(crate::reproduce::sensor::rows(scenario_dir)?);
+            let mut rows = crate::reproduce::sensor::rows(scenario_dir)?;
+            rows.extend(crate::reproduce::gripper::rows(scenario_dir, &[])?);
             Ok(rows)
         }
-        other => anyhow::bail!("reproduce {other}: unknown (expected sensor or all)"),
+        other => anyhow::bail!("reproduce {other}: unknown (expected sensor, gripper or all)"),
     }
 }

@@ -12,8 +12,10 @@ pub struct SlipConfig {
     /// (the setpoint). 0.5: the paper's held runs dip to 72 % of the setpoint at worst
     /// (crimper, 0.43 N of 0.6 N), so half the setpoint is clearly outside normal fluctuation.
     pub slip_fraction: f64,
-    /// Contact is taken as lost below this force [N]: 20× the sensor's noise-limited
-    /// resolution (2.57 mN, paper Sec. IV-B), well above the noise floor.
+    /// Contact is taken as lost when the estimate is within this force [N] of the unloaded
+    /// reading: 20× the sensor's noise-limited resolution (2.57 mN, paper Sec. IV-B). The
+    /// unloaded reading is not 0 N with the paper's calibration (its −91.42 pm intercept makes
+    /// eq. (8) read ≈ 0.16 N at zero shift), so the threshold is relative to it.
     pub lost_force_n: f64,
     /// The force must stay below `lost_force_n` this long [s] before the object is declared
     /// lost, so single noisy samples do not trigger it.
@@ -57,9 +59,17 @@ impl SlipDetector {
         SlipDetector { config, events: SlipEvents::default(), below_since: None }
     }
 
-    /// Feeds one estimate. `holding` is true in the phases where the object must stay in the
-    /// hand; `reference_n` is the force the grasp should have (the setpoint).
-    pub fn update(&mut self, time_s: f64, force_n: f64, reference_n: f64, holding: bool) -> SlipEvents {
+    /// Feeds one estimate. `unloaded_n` is what the estimator reads with nothing on the sensor
+    /// (the estimate at the tare); `holding` is true in the phases where the object must stay in
+    /// the hand; `reference_n` is the force the grasp should have (the setpoint).
+    pub fn update(
+        &mut self,
+        time_s: f64,
+        force_n: f64,
+        unloaded_n: f64,
+        reference_n: f64,
+        holding: bool,
+    ) -> SlipEvents {
         if !holding || self.events.lost_s.is_some() {
             self.below_since = None;
             return self.events;
@@ -67,7 +77,7 @@ impl SlipDetector {
         if self.events.slip_start_s.is_none() && force_n < self.config.slip_fraction * reference_n {
             self.events.slip_start_s = Some(time_s);
         }
-        if force_n < self.config.lost_force_n {
+        if force_n - unloaded_n < self.config.lost_force_n {
             let since = *self.below_since.get_or_insert(time_s);
             if time_s - since >= self.config.lost_hold_s {
                 self.events.lost_s = Some(since);
@@ -96,7 +106,7 @@ mod tests {
         for i in 0..1000 {
             let t = i as f64 * 0.01;
             let f = if t < 2.0 { 1.6 } else { (1.6 * (1.0 - (t - 2.0) / 4.0)).max(0.0) };
-            d.update(t, f, 1.6, true);
+            d.update(t, f, 0.0, 1.6, true);
         }
         let e = d.events();
         assert!((e.slip_start_s.unwrap() - 4.0).abs() < 0.02, "{e:?}");
@@ -109,11 +119,11 @@ mod tests {
         for i in 0..100 {
             let t = i as f64 * 0.01;
             let f = if i % 10 == 0 { 0.0 } else { 1.0 };
-            d.update(t, f, 1.0, true);
+            d.update(t, f + 0.16, 0.16, 1.0, true);
         }
         assert_eq!(d.events().lost_s, None);
-        d.update(1.0, 0.0, 1.0, false);
-        d.update(2.0, 0.0, 1.0, false);
+        d.update(1.0, 0.0, 0.0, 1.0, false);
+        d.update(2.0, 0.0, 0.0, 1.0, false);
         assert_eq!(d.events().lost_s, None);
     }
 }

@@ -81,9 +81,11 @@ pub struct TaskConfig {
     /// Growth feed speed [m/s]. 5 cm/s is a quarter of what the MX-106 (45 rpm) gives on a
     /// 12 mm pinion, a gentle feed for a soft strip.
     pub growth_speed_m_s: f64,
-    /// Twine speed of the guarded close before force control [°/s].
+    /// Twine speed of the guarded close before force control [°/s]: the PID's own speed limit.
     pub wrap_speed_deg_s: f64,
-    /// Force estimate that ends the guarded close [N]: first contact, 4× the detector's floor.
+    /// Rise of the force estimate above its unloaded reading that ends the guarded close [N]:
+    /// first contact. 0.1 N is 40× the noise-limited resolution (paper: 2.57 mN), well clear of
+    /// noise, and a sixth of the smallest setpoint (0.6 N), early enough to start force control.
     pub wrap_contact_n: f64,
     /// Longest guarded close [s]; past it the grasp starts anyway (and will likely fail).
     pub wrap_timeout_s: f64,
@@ -114,8 +116,8 @@ impl Default for TaskConfig {
             settle_s: 0.5,
             growth_m: 0.14,
             growth_speed_m_s: 0.05,
-            wrap_speed_deg_s: 45.0,
-            wrap_contact_n: 0.2,
+            wrap_speed_deg_s: 90.0,
+            wrap_contact_n: 0.1,
             wrap_timeout_s: 20.0,
             grasp_s: 15.0,
             lift_s: 11.0,
@@ -182,6 +184,7 @@ pub struct TaskSequencer {
     twine_deg: f64,
     growth_m: f64,
     motion_start_s: Option<f64>,
+    unloaded_n: f64,
 }
 
 fn radians(deg: &[f64; ARM_JOINTS]) -> [f64; ARM_JOINTS] {
@@ -211,7 +214,14 @@ impl TaskSequencer {
             twine_deg: 0.0,
             growth_m: 0.0,
             motion_start_s: None,
+            unloaded_n: 0.0,
         }
+    }
+
+    /// Sets what the estimator reads with nothing on the sensor [N] (the estimate at the tare);
+    /// the guarded close looks for a rise above it.
+    pub fn set_unloaded_reading(&mut self, force_n: f64) {
+        self.unloaded_n = force_n;
     }
 
     /// The current phase.
@@ -259,7 +269,9 @@ impl TaskSequencer {
         let next = match self.phase {
             Phase::Home if elapsed >= self.task.settle_s => Some(Phase::Grow),
             Phase::Grow if self.growth_m >= self.task.growth_m => Some(Phase::Wrap),
-            Phase::Wrap if force_n >= self.task.wrap_contact_n || elapsed >= self.task.wrap_timeout_s => {
+            Phase::Wrap
+                if force_n - self.unloaded_n >= self.task.wrap_contact_n || elapsed >= self.task.wrap_timeout_s =>
+            {
                 Some(Phase::Grasp)
             }
             Phase::Grasp if elapsed >= self.task.grasp_s => Some(Phase::Lift),

@@ -83,4 +83,5 @@ mod tests {
         assert!(table.contains("FAIL"));
     }
 }
+pub mod gripper;
 pub mod sensor;

@@ -1,11 +1,15 @@
 //! Running the pick-and-place task on a cell and recording it.
 //!
+//! - [`execute`]: one scenario on the twin, files written.
 //! - [`runner`]: the control loop over any [`crate::hardware::Cell`].
+//! - [`scenario`]: the pick-and-place scenario file.
 //! - [`trace`]: `trace.csv`, one row per tick.
 //! - [`metrics`]: rise time, overshoot, fluctuation, estimate error.
 //! - [`summary`]: the `summary.json` record.
 
+pub mod execute;
 pub mod metrics;
 pub mod runner;
+pub mod scenario;
 pub mod summary;
 pub mod trace;

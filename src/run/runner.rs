@@ -97,19 +97,22 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
         cell.activate()?;
         let mut estimator = ForceEstimator::new(plan.calibration.clone());
         let mut tare = TareAverager::default();
+        let mut unloaded_n = 0.0;
         for tick in 0u64.. {
             let state = cell.read()?;
             if sequencer.phase() == Phase::Home {
                 // Tare on the mean of the samples at home, finger retracted and untouched.
                 tare.add(state.wavelengths);
                 estimator.tare(tare.mean());
+                unloaded_n = estimator.estimate(tare.mean()).map_or(0.0, |e| e.force_n);
+                sequencer.set_unloaded_reading(unloaded_n);
             }
             let estimate = estimator.track(state.wavelengths).map_err(|e| CellError::Device {
                 device: "estimator".into(),
                 cause: format!("at t = {:.3} s: {e}", state.time_s),
             })?;
             let decision = sequencer.update(&state, estimate.force_n, dt);
-            slip.update(state.time_s, estimate.force_n, plan.setpoint_n, decision.phase.holding());
+            slip.update(state.time_s, estimate.force_n, unloaded_n, plan.setpoint_n, decision.phase.holding());
             cell.write(&decision.command)?;
 
             let truth = cell.ground_truth();

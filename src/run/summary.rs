@@ -120,3 +120,38 @@ impl RunSummary {
         }
     }
 }
+
+/// A short human-readable summary, a line per figure.
+pub fn render_text(s: &RunSummary) -> String {
+    let opt = |v: Option<f64>, unit: &str| v.map_or("-".to_string(), |v| format!("{v:.2} {unit}"));
+    let mut out = format!(
+        "{} ({}, {:.0} g, setpoint {} N, feedback {}, Kp {} Ki {} Kd {}, seed {}, {})\n",
+        s.scenario,
+        s.object,
+        s.mass_kg * 1e3,
+        s.setpoint_n,
+        if s.feedback { "on" } else { "off" },
+        s.gains.kp,
+        s.gains.ki,
+        s.gains.kd,
+        s.seed,
+        s.backend
+    );
+    out += &format!("  outcome            {}", s.outcome);
+    if let (Some(t), Some(p)) = (s.drop_time_s, &s.drop_phase) {
+        out += &format!(" at {t:.2} s after the arm started moving, during {p}");
+    }
+    out += "\n";
+    if let Some(e) = &s.error {
+        out += &format!("  error              {e}\n");
+    }
+    out += &format!("  rise time (90 %)   {}\n", opt(s.rise_time_90_s, "s"));
+    out += &format!("  overshoot          {:.1} %\n", s.overshoot_pct);
+    out += &format!("  max fluctuation    {}\n", opt(s.max_fluctuation_pct, "%"));
+    out += &format!("  estimate RMSE      {}\n", opt(s.force_rmse_n, "N"));
+    out += &format!(
+        "  simulated {:.1} s in {:.2} s wall: {:.0}x real time\n",
+        s.sim_time_s, s.wall_time_s, s.real_time_factor
+    );
+    out
+}
