@@ -4,7 +4,7 @@ use super::runner::{Outcome, RunReport};
 use serde::{Deserialize, Serialize};
 
 /// PID gains as reported.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Gains {
     /// Proportional gain [(°/s)/N].
     pub kp: f64,
@@ -16,7 +16,7 @@ pub struct Gains {
 
 /// The summary of one run. Times are in seconds; `drop_time_s` counts from the moment the arm
 /// started moving the object (the paper's Fig. 9 time axis), `drop_cell_time_s` from activation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct RunSummary {
     /// Scenario name.
     pub scenario: String,
@@ -86,6 +86,17 @@ pub struct RunIdentity {
 }
 
 impl RunSummary {
+    /// A summary for a run that could not start (its scenario failed to build): outcome
+    /// "error" with the cause, so a sweep records it and goes on.
+    pub fn failed_to_start(scenario: &str, cause: String) -> RunSummary {
+        RunSummary { scenario: scenario.into(), outcome: "error".into(), error: Some(cause), ..Default::default() }
+    }
+
+    /// The column names of a flattened summary, in order (nested fields dotted: `gains.kp`).
+    pub fn columns() -> Vec<String> {
+        crate::sweep::results::flatten_summary(&RunSummary::default()).into_iter().map(|(k, _)| k).collect()
+    }
+
     /// Builds the summary from a run's identity, report and wall time.
     pub fn new(id: RunIdentity, report: &RunReport, wall_time_s: f64) -> RunSummary {
         let since_motion = |t: f64| report.motion_start_s.map(|m| t - m);

@@ -2,7 +2,9 @@
 //!
 //! - [`spec`]: the sweep file and its expansion into runs.
 //! - [`results`]: the incremental `results.csv`, resume and shard merging.
+//! - [`execute`]: checking and running the runs in parallel.
 
+pub mod execute;
 pub mod results;
 pub mod spec;
 
