@@ -41,6 +41,15 @@ enum Command {
         #[arg(long = "set")]
         set: Vec<String>,
     },
+    /// Draw charts (PNG and SVG): a run directory's force trace, a sweep directory's heatmaps, or
+    /// the charts of speed_accuracy.csv, stability.csv and gain_map.csv (a file or its folder).
+    Plot {
+        /// A run directory, a sweep directory, or one of the CSV files.
+        path: std::path::PathBuf,
+        /// Write the charts here (default: next to the input).
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
 }
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
@@ -80,6 +89,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                     std::fs::write(&path, csv).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?
                 }
                 None => print!("{csv}"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Plot { path, out } => {
+            for file in crate::plot::plot_path(&path, out.as_deref())? {
+                println!("{}", file.display());
             }
             Ok(ExitCode::SUCCESS)
         }
