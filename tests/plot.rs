@@ -44,7 +44,7 @@ fn write_run(dir: &Path, drop: bool) {
     for i in 0..1700 {
         let t = i as f64 * 0.01;
         let phase = phases.iter().find(|p| t < p.0).map_or("done", |p| p.1);
-        let control = t >= 5.0 && t < 14.5 && !(drop && t >= 11.0);
+        let control = (5.0..14.5).contains(&t) && !(drop && t >= 11.0);
         let target = match phase {
             "wrap" => 0.3 * (t - 3.0) / 2.0,
             "grasp" | "lift" | "transfer" | "lower" => 1.0 + 0.15 * (6.0 * t).sin() * f64::from(u8::from(t > 8.0)),

@@ -80,9 +80,12 @@ where
     DB::ErrorType: 'static,
 {
     let (w, _) = area.dim_in_pixel();
+    // Same width for a colour bar and short swatch texts, so panels side by side line up.
     let key_w = match key {
-        Key::ColorBar { .. } => 120,
-        Key::Swatches(_) => 190,
+        Key::ColorBar { .. } => 130,
+        Key::Swatches(items) => {
+            items.iter().map(|(_, t)| 40 + 9 * t.chars().count() as u32).max().unwrap_or(0).max(130)
+        }
     };
     let (main, side) = area.split_horizontally(w.saturating_sub(key_w));
     let nx = kp.len().max(1);

@@ -205,6 +205,9 @@ impl Chart for SpeedAccuracy {
         };
         for i in &front {
             let r = &self.rows[*i];
+            if r.is_default {
+                continue; // labelled below as the default
+            }
             if let Some((s, e)) = plottable(r) {
                 note(format!("  {}", settings(r)), (s * 1.08, e), VPos::Top)?;
             }
@@ -214,7 +217,9 @@ impl Chart for SpeedAccuracy {
             // The reference has zero error against itself; it sits on the bottom edge then.
             let e = plottable(r).map_or(y_lo * 1.4, |p| p.1);
             chart.plotting_area().draw(&TriangleMarker::new((s, e), 10, BLACK.filled()))?;
-            note(format!("  reference: {} ({})", settings(r), r.integrator), (s * 1.05, e), VPos::Center)?;
+            let zero = if plottable(r).is_none() { ", zero error by definition" } else { "" };
+            let text = format!("  reference: {} ({}){zero}", settings(r), r.integrator);
+            note(text, (s * 1.05, e), VPos::Center)?;
         }
         for r in self.rows.iter().filter(|r| r.is_default) {
             if let Some((s, e)) = plottable(r) {

@@ -107,13 +107,15 @@ impl Chart for Stability {
         } else {
             "Stability per backend and integrator: timesteps tried and their outcome".to_string()
         };
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, style::TITLE))
+        let root = root.titled(&title, (FONT, style::TITLE))?;
+        let (w, _) = root.dim_in_pixel();
+        let (plot, key) = root.split_horizontally(w - 230);
+        let mut chart = ChartBuilder::on(&plot)
             .margin(16)
-            .margin_right(40)
+            .margin_right(30)
             .x_label_area_size(56)
             .y_label_area_size(if one_backend { 130 } else { 210 })
-            .build_cartesian_2d(((lo / 2.0)..(hi * 2.5)).log_scale(), -0.5..n as f64 - 0.5)?;
+            .build_cartesian_2d(((lo / 1.6)..(hi * 1.6)).log_scale(), -0.5..n as f64 - 0.5)?;
         chart
             .configure_mesh()
             .y_max_light_lines(0)
@@ -127,40 +129,31 @@ impl Chart for Stability {
                 super::grid::index_label(*v).and_then(|i| names.get(i).cloned()).unwrap_or_default()
             })
             .draw()?;
+        // The key, outside the data so it hides no point.
+        let mut y = 40;
         for (name, color, text) in OUTCOMES {
             let pts: Vec<(f64, f64)> =
                 self.rows.iter().filter(|r| r.outcome == name).map(|r| (r.timestep_s, self.y(r))).collect();
             if pts.is_empty() {
                 continue;
             }
-            chart
-                .draw_series(pts.into_iter().map(|p| Circle::new(p, 9, color.filled())))?
-                .label(text)
-                .legend(move |(x, y)| Circle::new((x + 10, y), 7, color.filled()));
+            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 9, color.filled())))?;
+            key.draw(&Circle::new((20, y), 8, color.filled()))?;
+            key.draw(&Text::new(text, (38, y - 8), (FONT, style::LABEL).into_font()))?;
+            y += 28;
         }
-        let mut ringed = false;
+        key.draw(&Circle::new((20, y), 12, BLACK.stroke_width(3)))?;
+        key.draw(&Text::new("largest stable", (38, y - 17), (FONT, style::LABEL).into_font()))?;
+        key.draw(&Text::new("timestep", (38, y + 1), (FONT, style::LABEL).into_font()))?;
         for (b, g) in &self.groups {
             let rows: Vec<&StabilityRow> = self.rows.iter().filter(|r| r.backend == *b && r.integrator == *g).collect();
             if let Some(dt) = largest_stable(&rows) {
                 let y = self.y(rows[0]);
-                let series = chart.draw_series(std::iter::once(Circle::new((dt, y), 15, BLACK.stroke_width(3))))?;
-                if !ringed {
-                    series
-                        .label("largest stable timestep")
-                        .legend(|(x, y)| Circle::new((x + 10, y), 9, BLACK.stroke_width(2)));
-                    ringed = true;
-                }
+                chart.draw_series(std::iter::once(Circle::new((dt, y), 15, BLACK.stroke_width(3))))?;
                 let font = TextStyle::from((FONT, style::SMALL).into_font()).pos(Pos::new(HPos::Center, VPos::Bottom));
-                chart.plotting_area().draw(&Text::new(format!("{}", style::timestep(dt)), (dt, y + 0.32), font))?;
+                chart.plotting_area().draw(&Text::new(style::timestep(dt), (dt, y + 0.32), font))?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, style::LABEL))
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .draw()?;
         Ok(())
     }
 }

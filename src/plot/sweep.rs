@@ -81,6 +81,9 @@ pub fn render(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathBuf>, PlotErr
     Ok(written)
 }
 
+/// Picks one metric out of a row.
+type Metric = fn(&SweepRow) -> Option<f64>;
+
 /// One object's four heatmaps.
 struct SweepFigure {
     title: String,
@@ -136,7 +139,7 @@ impl SweepFigure {
             .collect()
     }
 
-    fn metric_cells(&self, f: fn(&SweepRow) -> Option<f64>) -> (Vec<Cell>, f64, f64) {
+    fn metric_cells(&self, f: Metric) -> (Vec<Cell>, f64, f64) {
         let means: Vec<((usize, usize), Option<f64>)> = self
             .cells
             .iter()
@@ -177,7 +180,7 @@ impl Chart for SweepFigure {
             (style::NONE, "error".into()),
         ]);
         grid::panel(&panels[0], "Outcome", &self.kp, &self.ki, &self.outcome_cells(), &swatches)?;
-        let metrics: [(&str, &str, fn(&SweepRow) -> Option<f64>); 3] = [
+        let metrics: [(&str, &str, Metric); 3] = [
             ("Rise time to 90 % of setpoint", "rise time [s]", |r| r.rise_time_90_s),
             ("Overshoot during the grasp", "overshoot [%]", |r| r.overshoot_pct),
             ("Largest fluctuation while moving (held runs)", "fluctuation [%]", |r| r.max_fluctuation_pct),
