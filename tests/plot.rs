@@ -335,3 +335,19 @@ fn cli_prints_files_and_fails_cleanly() {
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(stderr.contains("missing") && !stderr.contains("panicked"), "{stderr}");
 }
+
+#[test]
+fn dense_gain_grid_still_renders() {
+    let (_keep, dir) = workdir("dense");
+    let mut s = String::from("object,kp,ki,outcome,oscillating\n");
+    for i in 0..30 {
+        for j in 0..25 {
+            let (kp, ki) = (0.1 * 1.2f64.powi(i), 0.05 * 1.25f64.powi(j));
+            writeln!(s, "cup,{kp},{ki},{},{}", if kp * (1.0 + ki) > 1.0 { "held" } else { "dropped" }, kp * ki > 20.0)
+                .unwrap();
+        }
+    }
+    std::fs::write(dir.join("gain_map.csv"), s).unwrap();
+    let files = plot::plot_path(&dir, None).unwrap();
+    check_pair(&files, "gain_map_cup", (1000, 760), "Closed-loop map over the PID gains: cup");
+}

@@ -104,8 +104,9 @@ where
         .y_desc(KI_AXIS)
         .axis_desc_style((FONT, style::AXIS))
         .label_style((FONT, style::LABEL))
-        .x_labels(nx + 1)
-        .y_labels(ny + 1)
+        // At most one label per ~60 px across and ~24 px up; plotters then labels every 2nd or 5th cell.
+        .x_labels((nx + 1).min(main.dim_in_pixel().0 as usize / 60))
+        .y_labels((ny + 1).min(main.dim_in_pixel().1 as usize / 24))
         .x_label_formatter(&|v| label_of(kp, *v).unwrap_or_default())
         .y_label_formatter(&|v| label_of(ki, *v).unwrap_or_default())
         .draw()?;
