@@ -125,6 +125,13 @@ fn write_speed_accuracy(dir: &Path) {
                     let reference = *integrator == "RK4" && dt == 0.0005 && cone == "elliptic" && segs == 16;
                     let default = *integrator == "implicitfast" && dt == 0.002 && cone == "pyramidal" && segs == 8;
                     let diverged = *integrator == "Euler" && dt == 0.005;
+                    let drop_err = if diverged {
+                        String::new()
+                    } else if reference {
+                        "0".into()
+                    } else {
+                        format!("{:.4}", dt * [2.0, 1.0, 1.0, 0.5][k] * if segs == 8 { 3.0 } else { 1.0 })
+                    };
                     let rmse = if reference {
                         0.0
                     } else {
@@ -134,7 +141,7 @@ fn write_speed_accuracy(dir: &Path) {
                         if diverged { (String::new(), "diverged") } else { (format!("{rmse:.5}"), "ok") };
                     writeln!(
                         s,
-                        "mujoco,{integrator},{cone},{dt},{segs},{speed:.3},{rmse},,{status},{default},{reference}"
+                        "mujoco,{integrator},{cone},{dt},{segs},{speed:.3},{rmse},{drop_err},{status},{default},{reference}"
                     )
                     .unwrap();
                 }
@@ -242,7 +249,8 @@ fn speed_accuracy_chart_and_front() {
     // Diverged and reference (zero error) rows are never on the front.
     assert!(front.iter().all(|i| rows[*i].status == "ok" && !rows[*i].is_reference));
     let files = plot::speed_accuracy::render(&rows, &dir).unwrap();
-    check_pair(&files, "speed_accuracy", (1200, 820), "Speed against accuracy");
+    check_pair(&files, "speed_accuracy", (1200, 1160), "Speed against accuracy");
+    assert!(std::fs::read_to_string(dir.join("speed_accuracy.svg")).unwrap().contains("Drop-time error"));
     let svg = std::fs::read_to_string(dir.join("speed_accuracy.svg")).unwrap();
     assert!(svg.contains("default: 2 ms") && svg.contains("reference: 500 µs"));
 }

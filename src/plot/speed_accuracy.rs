@@ -118,9 +118,69 @@ fn distinct<'a>(values: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
     out
 }
 
+impl SpeedAccuracy {
+    /// (row, speed, |drop-time error|) of the settled runs with a drop-time error.
+    fn drop_errors(&self) -> Vec<(&SpeedAccuracyRow, f64, f64)> {
+        self.rows
+            .iter()
+            .filter(|r| r.status == "ok")
+            .filter_map(|r| {
+                let s = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0)?;
+                let e = r.drop_time_error_s.filter(|e| e.is_finite())?;
+                Some((r, s, e.abs()))
+            })
+            .collect()
+    }
+
+    /// The second accuracy measure: |drop-time error| against speed; zero errors on the bottom edge.
+    fn draw_drop_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        drops: &[(&SpeedAccuracyRow, f64, f64)],
+        x: std::ops::Range<f64>,
+    ) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let nonzero = drops.iter().map(|d| d.2).filter(|e| *e > 0.0);
+        let (lo, hi) = nonzero.fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(e), b.max(e)));
+        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (1e-3, 1.0) };
+        let (y_lo, y_hi) = (lo / 4.0, hi * 2.0);
+        let mut chart = ChartBuilder::on(area)
+            .caption("Drop-time error (exact drops on the bottom edge)", (FONT, style::CAPTION))
+            .margin(16)
+            .margin_right(30)
+            .x_label_area_size(56)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x.log_scale(), (y_lo..y_hi).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("speed [simulated s per wall-clock s] (log)")
+            .y_desc("|drop-time error| [s] (log)")
+            .axis_desc_style((FONT, style::AXIS))
+            .label_style((FONT, style::LABEL))
+            .x_label_formatter(&|v| style::num(*v))
+            .y_label_formatter(&|v| style::num(*v))
+            .draw()?;
+        let integrators = distinct(self.rows.iter().map(|r| r.integrator.as_str()));
+        let backends = distinct(self.rows.iter().map(|r| r.backend.as_str()));
+        chart.draw_series(drops.iter().map(|(r, s, e)| {
+            let k = integrators.iter().position(|i| *i == r.integrator).unwrap_or(0);
+            let m = backends.iter().position(|b| *b == r.backend).unwrap_or(0);
+            let y = if *e > 0.0 { *e } else { y_lo * 1.3 };
+            marker(m, (*s, y), style::SERIES[k % style::SERIES.len()])
+        }))?;
+        for (_, s, e) in drops.iter().filter(|d| d.0.is_default) {
+            let y = if *e > 0.0 { *e } else { y_lo * 1.3 };
+            chart.plotting_area().draw(&Circle::new((*s, y), 15, BLACK.stroke_width(3)))?;
+        }
+        Ok(())
+    }
+}
+
 impl Chart for SpeedAccuracy {
     fn size(&self) -> (u32, u32) {
-        (1200, 820)
+        if self.drop_errors().is_empty() { (1200, 820) } else { (1200, 1160) }
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
@@ -136,8 +196,19 @@ impl Chart for SpeedAccuracy {
         let (e_lo, e_hi) = if e_lo.is_finite() { (e_lo, e_hi) } else { (1e-3, 1.0) };
         // Room below for the reference (zero error) and above for failed runs.
         let (y_lo, y_hi) = (e_lo / 4.0, e_hi * 4.0);
-        let mut chart = ChartBuilder::on(root)
-            .caption("Speed against accuracy of the simulation settings", (FONT, style::TITLE))
+        let root = root.titled("Speed against accuracy of the simulation settings", (FONT, style::TITLE))?;
+        let drops = self.drop_errors();
+        let (top, bottom) = if drops.is_empty() {
+            (root.clone(), None)
+        } else {
+            let (_, h) = root.dim_in_pixel();
+            let (a, b) = root.split_vertically(h - 330);
+            (a, Some(b))
+        };
+        if let Some(area) = &bottom {
+            self.draw_drop_panel(area, &drops, (s_lo / 2.0)..(s_hi * 2.0))?;
+        }
+        let mut chart = ChartBuilder::on(&top)
             .margin(16)
             .margin_right(30)
             .x_label_area_size(56)
