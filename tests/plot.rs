@@ -25,9 +25,9 @@ fn workdir(name: &str) -> (Option<tempfile::TempDir>, PathBuf) {
 const TRACE_HEADER: &str = "time_s,phase,true_force_n,fbg1_nm,fbg2_nm,force_n,force_uncompensated_n,over_range,setpoint_n,\
 controller_on,controller_output_deg_s,growth_motor_rad,twine_motor_rad,object_height_m,slip_speed_m_s,grip_force_n";
 
-/// A 17 s run at 100 Hz: contact in wrap, PI rise in grasp, the arm moves from 8 s; dropped at
+/// A 17 s run at `hz`: contact in wrap, PI rise in grasp, the arm moves from 8 s; dropped at
 /// 11 s when `drop` is set.
-fn write_run(dir: &Path, drop: bool) {
+fn write_run(dir: &Path, drop: bool, hz: usize) {
     let phases = [
         (1.0, "home"),
         (3.0, "grow"),
@@ -41,8 +41,9 @@ fn write_run(dir: &Path, drop: bool) {
     ];
     let mut s = format!("{TRACE_HEADER}\n");
     let mut f = 0.0f64;
-    for i in 0..1700 {
-        let t = i as f64 * 0.01;
+    let dt = 1.0 / hz as f64;
+    for i in 0..17 * hz {
+        let t = i as f64 * dt;
         let phase = phases.iter().find(|p| t < p.0).map_or("done", |p| p.1);
         let control = (5.0..14.5).contains(&t) && !(drop && t >= 11.0);
         let target = match phase {
@@ -51,7 +52,7 @@ fn write_run(dir: &Path, drop: bool) {
             _ => 0.0,
         };
         let target = if drop && t >= 11.0 { 0.0 } else { target };
-        f += (target - f) * 0.08;
+        f += (target - f) * (8.0 * dt).min(1.0);
         let out = if control { 40.0 * (1.0 - f) + 5.0 * (3.0 * t).cos() } else { 0.0 };
         let truth = if t < 0.2 { f64::NAN } else { f * 1.03 };
         writeln!(
@@ -204,7 +205,7 @@ fn check_pair(files: &[PathBuf], stem: &str, size: (u32, u32), title: &str) {
 fn run_trace_held_and_dropped() {
     for (name, drop) in [("run-held", false), ("run-dropped", true)] {
         let (_keep, dir) = workdir(name);
-        write_run(&dir, drop);
+        write_run(&dir, drop, 100);
         let run = plot::trace::read(&dir).unwrap();
         assert!(run.points[0].true_force_n.is_nan());
         let files = plot::trace::render(&run, &dir).unwrap();
@@ -294,7 +295,7 @@ fn plot_path_finds_every_input() {
 #[test]
 fn bad_input_names_file_and_line() {
     let (_keep, dir) = workdir("bad");
-    write_run(&dir, false);
+    write_run(&dir, false, 100);
     let trace = dir.join("trace.csv");
     let mut lines: Vec<String> = std::fs::read_to_string(&trace).unwrap().lines().map(String::from).collect();
     lines[4] = lines[4].replacen(",home,", ",home,oops", 1);
@@ -316,7 +317,7 @@ fn bad_input_names_file_and_line() {
     assert!(e.contains("gain_map.csv:2:") && e.contains("wobbly"), "{e}");
 
     std::fs::write(dir.join("summary.json"), "{\n \"outcome\": 3\n}").unwrap();
-    write_run(&dir, false);
+    write_run(&dir, false, 100);
     std::fs::write(dir.join("summary.json"), "{\n \"outcome\": 3\n}").unwrap();
     let e = plot::trace::read(&dir).unwrap_err().to_string();
     assert!(e.contains("summary.json:2:"), "{e}");
@@ -358,4 +359,15 @@ fn dense_gain_grid_still_renders() {
     std::fs::write(dir.join("gain_map.csv"), s).unwrap();
     let files = plot::plot_path(&dir, None).unwrap();
     check_pair(&files, "gain_map_cup", (1000, 760), "Closed-loop map over the PID gains: cup");
+}
+
+#[test]
+fn long_trace_is_thinned() {
+    let (_keep, dir) = workdir("run-long");
+    write_run(&dir, true, 2000);
+    let files = plot::plot_path(&dir, None).unwrap();
+    check_pair(&files, "trace", (1400, 900), "Force trace");
+    // 34,000 ticks x 4 lines would be megabytes of SVG; min/max thinning keeps it small.
+    let svg = std::fs::metadata(dir.join("trace.svg")).unwrap().len();
+    assert!(svg < 1_500_000, "trace.svg is {svg} bytes");
 }

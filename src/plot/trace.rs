@@ -298,12 +298,21 @@ impl Chart for TraceChart<'_> {
                 fc.draw_series(std::iter::once(Rectangle::new([(a, f_range.start), (b, f_range.end)], c.filled())))?;
                 oc.draw_series(std::iter::once(Rectangle::new([(a, o_range.start), (b, o_range.end)], c.filled())))?;
             }
-            let (pa, _) = fc.backend_coord(&(a, f_range.end));
-            let (pb, _) = fc.backend_coord(&(b, f_range.end));
-            if (pb - pa) as usize > phase.len() * 8 + 6 {
+            let px = |t: f64| fc.backend_coord(&(t, f_range.end)).0;
+            let text_px = phase.len() as i32 * 8 + 6;
+            // Centre the name in the span, or in the wider side of it when the drop line crosses it.
+            let mut span = (a, b);
+            if let Some((t, _)) = &drop
+                && *t > a
+                && *t < b
+                && (px((a + b) / 2.0) - px(*t)).abs() < text_px / 2 + 4
+            {
+                span = if *t - a > b - *t { (a, *t) } else { (*t, b) };
+            }
+            if px(span.1) - px(span.0) > text_px {
                 let font = TextStyle::from((FONT, style::SMALL).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
                 let y = f_range.end - 0.015 * (f_range.end - f_range.start);
-                fc.plotting_area().draw(&Text::new(phase.to_string(), ((a + b) / 2.0, y), font))?;
+                fc.plotting_area().draw(&Text::new(phase.to_string(), ((span.0 + span.1) / 2.0, y), font))?;
             }
         }
 
