@@ -196,6 +196,10 @@ fn check_pair(files: &[PathBuf], stem: &str, size: (u32, u32), title: &str) {
     // Not a blank canvas: a good share of pixels is not white.
     let inked = buf.chunks(3).filter(|p| p.iter().any(|c| *c < 200)).count();
     assert!(inked > buf.len() / 3 / 50, "{} looks blank", png.display());
+    // The title band is inked: text renders from the embedded font, no system font needed.
+    let title_band = &buf[..(size.0 * 3 * 34) as usize];
+    let dark = title_band.chunks(3).filter(|p| p.iter().all(|c| *c < 100)).count();
+    assert!(dark > 200, "{}: title text missing ({dark} dark pixels)", png.display());
     let svg = png.with_extension("svg");
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains(title), "{} lacks its title {title:?}", svg.display());
@@ -370,4 +374,23 @@ fn long_trace_is_thinned() {
     // 34,000 ticks x 4 lines would be megabytes of SVG; min/max thinning keeps it small.
     let svg = std::fs::metadata(dir.join("trace.svg")).unwrap().len();
     assert!(svg < 1_500_000, "trace.svg is {svg} bytes");
+}
+
+#[test]
+fn sweep_cells_pool_repeated_gains() {
+    let (_keep, dir) = workdir("sweep-pooled");
+    // Only the columns the heatmaps need; two seeds per gain pair with different outcomes.
+    let mut s = String::from("object,gains.kp,gains.ki,outcome,rise_time_90_s,overshoot_pct,max_fluctuation_pct\n");
+    for kp in [1.0, 2.0] {
+        for ki in [0.0, 1.0] {
+            writeln!(s, "cup,{kp},{ki},held,6.5,2.0,10.0").unwrap();
+            writeln!(s, "cup,{kp},{ki},dropped,8.0,4.0,").unwrap();
+        }
+    }
+    std::fs::write(dir.join("results.csv"), s).unwrap();
+    let files = plot::plot_path(&dir, None).unwrap();
+    check_pair(&files, "sweep_cup", (1600, 1200), "up to 2 runs per cell");
+    let svg = std::fs::read_to_string(dir.join("sweep_cup.svg")).unwrap();
+    assert!(svg.contains("1/2"), "share held written in the cell");
+    assert!(svg.contains(">\n7.25\n<"), "mean rise time (6.5+8)/2 written in the cell");
 }

@@ -132,7 +132,7 @@ impl SweepFigure {
                     (style::BAD, "dropped".to_string())
                 } else {
                     let share = held as f64 / (n - errors) as f64;
-                    (style::blend(style::BAD, style::GOOD, share), format!("{held}/{n}"))
+                    (style::blend(style::BAD, style::GOOD, share), format!("{held}/{n} held"))
                 };
                 Cell { kp: *x, ki: *y, color, label }
             })
