@@ -18,7 +18,7 @@ impl Table {
     /// Reads `path`; a missing file, a ragged row or bad UTF-8 is an error naming the line.
     pub fn read(path: &Path) -> Result<Table, PlotError> {
         let file = path.display().to_string();
-        let text = std::fs::read(path).map_err(|e| PlotError::Io { file: file.clone(), source: e })?;
+        let text = std::fs::read(path).map_err(|e| PlotError::Io { file: file.clone(), cause: e })?;
         let csv_err = |e: csv::Error| PlotError::Malformed {
             file: file.clone(),
             line: e.position().map_or(1, |p| p.line()),

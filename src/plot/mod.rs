@@ -21,12 +21,12 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
     /// A file could not be read or written.
-    #[error("{file}: {source}")]
+    #[error("{file}: {cause}")]
     Io {
         /// The file.
         file: String,
-        /// The IO error.
-        source: std::io::Error,
+        /// The IO error (not a `source`: the message already holds it, and `{:#}` would repeat it).
+        cause: std::io::Error,
     },
     /// A file is not in the expected format; `line` is 1-based (the header is line 1).
     #[error("{file}:{line}: {message}")]
@@ -75,7 +75,7 @@ pub trait Chart {
 /// Writes `chart` as `out_dir/stem.png` and `out_dir/stem.svg` (creating `out_dir`); returns both paths.
 pub fn save<C: Chart>(chart: &C, out_dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
     style::register_fonts();
-    std::fs::create_dir_all(out_dir).map_err(|e| PlotError::Io { file: out_dir.display().to_string(), source: e })?;
+    std::fs::create_dir_all(out_dir).map_err(|e| PlotError::Io { file: out_dir.display().to_string(), cause: e })?;
     let size = chart.size();
     let png = out_dir.join(format!("{stem}.png"));
     let svg = out_dir.join(format!("{stem}.svg"));
@@ -114,7 +114,7 @@ pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotEr
     } else {
         return Err(PlotError::Io {
             file: path.display().to_string(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file or directory"),
+            cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file or directory"),
         });
     };
     let out_dir = out.map(Path::to_path_buf).unwrap_or_else(|| dir.clone());

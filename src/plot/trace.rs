@@ -115,7 +115,7 @@ pub fn read(run_dir: &Path) -> Result<RunTrace, PlotError> {
     let summary = if summary_path.is_file() {
         let file = summary_path.display().to_string();
         let text =
-            std::fs::read_to_string(&summary_path).map_err(|e| PlotError::Io { file: file.clone(), source: e })?;
+            std::fs::read_to_string(&summary_path).map_err(|e| PlotError::Io { file: file.clone(), cause: e })?;
         Some(serde_json::from_str::<SummaryInfo>(&text).map_err(|e| PlotError::Malformed {
             file,
             line: e.line() as u64,
