@@ -152,10 +152,11 @@ fn write_speed_accuracy(dir: &Path) {
     std::fs::write(dir.join("speed_accuracy.csv"), s).unwrap();
 }
 
-fn write_stability(dir: &Path) {
+fn write_stability(dir: &Path, backends: &[&str]) {
     let mut s = String::from("backend,integrator,timestep_s,outcome\n");
     let limits = [("Euler", 1e-3), ("implicitfast", 5e-3), ("implicit", 1e-2), ("RK4", 2e-3)];
-    for (integrator, limit) in limits {
+    for (b, (integrator, limit)) in backends.iter().flat_map(|b| limits.iter().map(move |l| (b, *l))) {
+        let limit = if *b == "mujoco" { limit } else { limit / 2.0 };
         for dt in [1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2] {
             let outcome = if dt <= limit {
                 "stable"
@@ -164,7 +165,7 @@ fn write_stability(dir: &Path) {
             } else {
                 "diverged"
             };
-            writeln!(s, "mujoco,{integrator},{dt},{outcome}").unwrap();
+            writeln!(s, "{b},{integrator},{dt},{outcome}").unwrap();
         }
     }
     std::fs::write(dir.join("stability.csv"), s).unwrap();
@@ -263,7 +264,7 @@ fn speed_accuracy_chart_and_front() {
 #[test]
 fn stability_chart_marks_largest_stable() {
     let (_keep, dir) = workdir("stability");
-    write_stability(&dir);
+    write_stability(&dir, &["mujoco"]);
     let rows = plot::stability::read(&dir.join("stability.csv")).unwrap();
     let euler: Vec<_> = rows.iter().filter(|r| r.integrator == "Euler").collect();
     assert_eq!(plot::stability::largest_stable(&euler), Some(1e-3));
@@ -285,7 +286,7 @@ fn gain_maps_per_object() {
 fn plot_path_finds_every_input() {
     let (_keep, dir) = workdir("all");
     write_speed_accuracy(&dir);
-    write_stability(&dir);
+    write_stability(&dir, &["mujoco"]);
     write_gain_map(&dir);
     let out = dir.join("charts");
     let files = plot::plot_path(&dir, Some(&out)).unwrap();
@@ -335,7 +336,7 @@ fn bad_input_names_file_and_line() {
 #[test]
 fn cli_prints_files_and_fails_cleanly() {
     let (_keep, dir) = workdir("cli");
-    write_stability(&dir);
+    write_stability(&dir, &["mujoco"]);
     let bin = env!("CARGO_BIN_EXE_tendril");
     let out = std::process::Command::new(bin).arg("plot").arg(&dir).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -393,4 +394,14 @@ fn sweep_cells_pool_repeated_gains() {
     let svg = std::fs::read_to_string(dir.join("sweep_cup.svg")).unwrap();
     assert!(svg.contains("1/2"), "share held written in the cell");
     assert!(svg.contains(">\n7.25\n<"), "mean rise time (6.5+8)/2 written in the cell");
+}
+
+#[test]
+fn stability_per_backend() {
+    let (_keep, dir) = workdir("stability-backends");
+    write_stability(&dir, &["mujoco", "rapier"]);
+    let files = plot::plot_path(&dir, None).unwrap();
+    check_pair(&files, "stability", (1100, 260 + 70 * 8), "Stability per backend and integrator");
+    let svg = std::fs::read_to_string(dir.join("stability.svg")).unwrap();
+    assert!(svg.contains("rapier / RK4") && svg.contains("mujoco / Euler"));
 }
