@@ -65,7 +65,7 @@ fn write_run(dir: &Path, drop: bool, hz: usize) {
     }
     std::fs::write(dir.join("trace.csv"), s).unwrap();
     let (outcome, drop_fields) = if drop {
-        ("dropped", r#""drop_time_s": 3.0, "drop_cell_time_s": 11.0, "drop_phase": "transfer""#)
+        ("dropped", r#""drop_time_s": 3.0, "drop_cell_time_s": 11.0, "drop_phase": "transfer", "slip_detected_s": 2.4"#)
     } else {
         ("held", r#""drop_time_s": null, "drop_cell_time_s": null, "drop_phase": null"#)
     };
@@ -217,6 +217,8 @@ fn run_trace_held_and_dropped() {
         check_pair(&files, "trace", (1400, 900), "Force trace: grip-cup");
         let svg = std::fs::read_to_string(dir.join("trace.svg")).unwrap();
         assert_eq!(svg.contains("drop at 11 s (transfer)"), drop);
+        assert_eq!(svg.contains("slip detected"), drop);
+        assert!(svg.contains("arm starts moving"));
         assert!(svg.contains("transfer") && svg.contains("grasp"), "phases named");
     }
 }

@@ -69,6 +69,8 @@ pub struct SummaryInfo {
     pub drop_time_s: Option<f64>,
     /// Phase of the drop.
     pub drop_phase: Option<String>,
+    /// When the sensor-based detector saw slip start, after the arm started moving [s].
+    pub slip_detected_s: Option<f64>,
     /// The error that ended the run.
     pub error: Option<String>,
 }
@@ -203,6 +205,8 @@ const UNC_C: RGBColor = style::SERIES[1];
 const SET_C: RGBColor = style::SERIES[2];
 const OUT_C: RGBColor = style::SERIES[3];
 const DROP_C: RGBColor = style::BAD;
+const MOVE_C: RGBColor = RGBColor(60, 60, 60);
+const SLIP_C: RGBColor = style::OTHER;
 
 impl TraceChart<'_> {
     fn title(&self) -> String {
@@ -221,6 +225,16 @@ impl TraceChart<'_> {
             t += &format!(": {o}");
         }
         t
+    }
+
+    /// Cell time when the arm starts moving the object (first `lift` tick), the paper's Fig. 9 origin.
+    fn motion_start(&self) -> Option<f64> {
+        self.run.points.iter().find(|p| p.phase == "lift").map(|p| p.time_s)
+    }
+
+    /// Cell time when the sensor saw slip start (the summary counts it from the motion start).
+    fn slip(&self) -> Option<f64> {
+        Some(self.motion_start()? + self.run.summary.as_ref()?.slip_detected_s?)
     }
 
     /// The drop to mark: (cell time, label).
@@ -337,6 +351,25 @@ impl Chart for TraceChart<'_> {
             oc.draw_series(LineSeries::new(line, OUT_C.stroke_width(2)))?;
         }
 
+        // Arm start and slip detection: solid lines, named near the bottom of the force panel.
+        // Names go left of their line (the force is high there while held; a drop's fall fills the
+        // right side), at two heights so that close lines do not overwrite each other.
+        let span = f_range.end - f_range.start;
+        let marks =
+            [(self.motion_start(), MOVE_C, "arm starts moving", 0.03), (self.slip(), SLIP_C, "slip detected", 0.10)];
+        for (t, c, text, dy) in marks {
+            let Some(t) = t else { continue };
+            fc.draw_series(LineSeries::new([(t, f_range.start), (t, f_range.end)], c.stroke_width(2)))?;
+            oc.draw_series(LineSeries::new([(t, o_range.start), (t, o_range.end)], c.stroke_width(2)))?;
+            let font =
+                TextStyle::from((FONT, style::SMALL).into_font()).color(&c).pos(Pos::new(HPos::Right, VPos::Bottom));
+            fc.plotting_area().draw(&Text::new(
+                text.to_string(),
+                (t - 0.005 * (t1 - t0), f_range.start + dy * span),
+                font,
+            ))?;
+        }
+
         if let Some((t, label)) = &drop {
             let f_line = [(*t, f_range.start), (*t, f_range.end)];
             fc.draw_series(DashedLineSeries::new(f_line, 10, 6, DROP_C.stroke_width(3)))?;
@@ -359,6 +392,12 @@ impl Chart for TraceChart<'_> {
         entries.push((EST_C, false, "estimate (compensated)"));
         entries.push((UNC_C, false, "uncompensated estimate"));
         entries.push((SET_C, true, "setpoint"));
+        if self.motion_start().is_some() {
+            entries.push((MOVE_C, false, "arm starts moving"));
+        }
+        if self.slip().is_some() {
+            entries.push((SLIP_C, false, "slip detected (sensor)"));
+        }
         if drop.is_some() {
             entries.push((DROP_C, true, "object dropped"));
         }
