@@ -192,13 +192,7 @@ impl TaskSequencer {
     /// A sequencer at the start of the task. `feedback_while_moving` keeps the force
     /// controller on during the arm's moves (the paper's second mode) or switches it off
     /// before the arm moves (the first mode).
-    pub fn new(
-        task: TaskConfig,
-        gripper: GripperConfig,
-        pid: Pid,
-        setpoint_n: f64,
-        feedback_while_moving: bool,
-    ) -> Self {
+    pub fn new(task: TaskConfig, gripper: GripperConfig, pid: Pid, setpoint_n: f64, feedback_while_moving: bool) -> Self {
         TaskSequencer {
             task,
             gripper,
@@ -303,8 +297,7 @@ impl TaskSequencer {
         if controller_on {
             // The integral must not wind up while the tendon is at a travel limit it pushes against.
             let tighten = self.setpoint_n > force_n;
-            let blocked =
-                (tighten && self.twine_deg >= self.gripper.twine_max_deg) || (!tighten && self.twine_deg <= 0.0);
+            let blocked = (tighten && self.twine_deg >= self.gripper.twine_max_deg) || (!tighten && self.twine_deg <= 0.0);
             controller_output = self.pid.update(self.setpoint_n, force_n, dt_s, blocked);
             self.twine_deg += controller_output * dt_s;
         }

@@ -47,12 +47,7 @@ pub struct JointMove {
 impl JointMove {
     /// Plans the fastest move within `limits` that lasts at least `min_duration_s`.
     /// Angles in radians.
-    pub fn plan(
-        from: [f64; ARM_JOINTS],
-        to: [f64; ARM_JOINTS],
-        limits: &JointLimits,
-        min_duration_s: f64,
-    ) -> JointMove {
+    pub fn plan(from: [f64; ARM_JOINTS], to: [f64; ARM_JOINTS], limits: &JointLimits, min_duration_s: f64) -> JointMove {
         let span = from.iter().zip(&to).map(|(a, b)| (b - a).abs()).fold(0.0, f64::max);
         if span == 0.0 {
             return JointMove { from, to, duration_s: min_duration_s.max(0.0), ramp_s: 0.0, peak_rate: 0.0 };
