@@ -66,6 +66,15 @@ enum Command {
         #[arg(long = "set")]
         set: Vec<crate::scenario::Override>,
     },
+    /// Draw charts (PNG and SVG): a run directory's force trace, a sweep directory's heatmaps, or
+    /// the charts of speed_accuracy.csv, stability.csv and gain_map.csv (a file or its folder).
+    Plot {
+        /// A run directory, a sweep directory, or one of the CSV files.
+        path: std::path::PathBuf,
+        /// Write the charts here (default: next to the input).
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
 }
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
@@ -131,6 +140,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 None => crate::scenario::from_str("", std::path::Path::new("(defaults)"), &set)?,
             };
             crate::cell::physics::check::run(&s)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Plot { path, out } => {
+            for file in crate::plot::plot_path(&path, out.as_deref())? {
+                println!("{}", file.display());
+            }
             Ok(ExitCode::SUCCESS)
         }
     }

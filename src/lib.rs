@@ -23,6 +23,7 @@ pub mod cell;
 pub mod cli;
 pub mod control;
 pub mod hardware;
+pub mod plot;
 pub mod reproduce;
 pub mod run;
 pub mod scenario;

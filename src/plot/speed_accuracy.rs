@@ -1,0 +1,336 @@
+//! `speed_accuracy.csv` as accuracy against speed (both log): one colour per integrator, one
+//! marker per backend, the Pareto front drawn through the non-dominated settings (faster and
+//! more accurate than any other), the default settings ringed and the reference marked.
+
+use super::input::Table;
+use super::style::{self, FONT};
+use super::{Chart, DrawResult, PlotError};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::{Path, PathBuf};
+
+/// One row of `speed_accuracy.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpeedAccuracyRow {
+    /// Physics backend.
+    pub backend: String,
+    /// Integrator name.
+    pub integrator: String,
+    /// Friction cone ("pyramidal", "elliptic").
+    pub cone: String,
+    /// Physics timestep [s].
+    pub timestep_s: f64,
+    /// Finger links.
+    pub segments: u32,
+    /// Simulated seconds per wall-clock second (None if the run failed before measuring).
+    pub sim_s_per_wall_s: Option<f64>,
+    /// RMSE of the sensor force against the reference run [N].
+    pub force_rmse_n: Option<f64>,
+    /// Drop-time error against the reference [s] (None when neither dropped).
+    pub drop_time_error_s: Option<f64>,
+    /// "ok", "diverged" or "error".
+    pub status: String,
+    /// These are the scenario's default settings.
+    pub is_default: bool,
+    /// This is the reference run (smallest timestep, finest finger).
+    pub is_reference: bool,
+}
+
+/// Reads `speed_accuracy.csv`.
+pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
+    let t = Table::read(path)?;
+    let c = |n: &str| t.column(n);
+    let (backend, integrator, cone, dt, segs) =
+        (c("backend")?, c("integrator")?, c("cone")?, c("timestep_s")?, c("segments")?);
+    let (speed, rmse, drop, status) =
+        (c("sim_s_per_wall_s")?, c("force_rmse_n")?, c("drop_time_error_s")?, c("status")?);
+    let (default, reference) = (c("is_default")?, c("is_reference")?);
+    let rows = t
+        .iter()
+        .map(|r| {
+            let segments = r.text(segs);
+            Ok(SpeedAccuracyRow {
+                backend: r.text(backend).to_string(),
+                integrator: r.text(integrator).to_string(),
+                cone: r.text(cone).to_string(),
+                timestep_s: r.positive(dt)?,
+                segments: segments
+                    .parse()
+                    .map_err(|_| r.error(format!("column `segments`: `{segments}` is not a whole number")))?,
+                sim_s_per_wall_s: r.opt_f64(speed)?,
+                force_rmse_n: r.opt_f64(rmse)?,
+                drop_time_error_s: r.opt_f64(drop)?,
+                status: r.one_of(status, &["ok", "diverged", "error"])?,
+                is_default: r.bool(default)?,
+                is_reference: r.bool(reference)?,
+            })
+        })
+        .collect::<Result<Vec<_>, PlotError>>()?;
+    if rows.is_empty() {
+        return Err(t.empty("no rows to plot"));
+    }
+    Ok(rows)
+}
+
+/// Indices of the rows on the Pareto front (faster and/or more accurate than all others),
+/// sorted by speed; only rows with status "ok" and a finite positive speed and error count.
+pub fn pareto_front(rows: &[SpeedAccuracyRow]) -> Vec<usize> {
+    let pts: Vec<(usize, f64, f64)> =
+        rows.iter().enumerate().filter_map(|(i, r)| plottable(r).map(|(s, e)| (i, s, e))).collect();
+    let mut front: Vec<(usize, f64, f64)> = pts
+        .iter()
+        .filter(|(i, s, e)| !pts.iter().any(|(j, s2, e2)| j != i && s2 >= s && e2 <= e && (s2 > s || e2 < e)))
+        .copied()
+        .collect();
+    front.sort_by(|a, b| a.1.total_cmp(&b.1));
+    front.into_iter().map(|p| p.0).collect()
+}
+
+/// (speed, error) of a row that can sit on log axes.
+fn plottable(r: &SpeedAccuracyRow) -> Option<(f64, f64)> {
+    let s = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0)?;
+    let e = r.force_rmse_n.filter(|e| e.is_finite() && *e > 0.0)?;
+    (r.status == "ok").then_some((s, e))
+}
+
+/// Draws `speed_accuracy.png/.svg` in `out_dir`; returns the files written.
+pub fn render(rows: &[SpeedAccuracyRow], out_dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    super::save(&SpeedAccuracy { rows: rows.to_vec() }, out_dir, "speed_accuracy")
+}
+
+struct SpeedAccuracy {
+    rows: Vec<SpeedAccuracyRow>,
+}
+
+/// Short description of a row's settings, for labels.
+fn settings(r: &SpeedAccuracyRow) -> String {
+    format!("{}, {} links, {}", style::timestep(r.timestep_s), r.segments, r.cone)
+}
+
+fn distinct<'a>(values: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for v in values {
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
+impl SpeedAccuracy {
+    /// (row, speed, |drop-time error|) of the settled runs with a drop-time error.
+    fn drop_errors(&self) -> Vec<(&SpeedAccuracyRow, f64, f64)> {
+        self.rows
+            .iter()
+            .filter(|r| r.status == "ok")
+            .filter_map(|r| {
+                let s = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0)?;
+                let e = r.drop_time_error_s.filter(|e| e.is_finite())?;
+                Some((r, s, e.abs()))
+            })
+            .collect()
+    }
+
+    /// The second accuracy measure: |drop-time error| against speed; zero errors on the bottom edge.
+    fn draw_drop_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        drops: &[(&SpeedAccuracyRow, f64, f64)],
+        x: std::ops::Range<f64>,
+    ) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let nonzero = drops.iter().map(|d| d.2).filter(|e| *e > 0.0);
+        let (lo, hi) = nonzero.fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(e), b.max(e)));
+        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (1e-3, 1.0) };
+        let (y_lo, y_hi) = (lo / 4.0, hi * 2.0);
+        let mut chart = ChartBuilder::on(area)
+            .caption("Drop-time error (exact drops on the bottom edge)", (FONT, style::CAPTION))
+            .margin(16)
+            .margin_right(30)
+            .x_label_area_size(56)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x.log_scale(), (y_lo..y_hi).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("speed [simulated s per wall-clock s] (log)")
+            .y_desc("|drop-time error| [s] (log)")
+            .axis_desc_style((FONT, style::AXIS))
+            .label_style((FONT, style::LABEL))
+            .x_label_formatter(&|v| style::num(*v))
+            .y_label_formatter(&|v| style::num(*v))
+            .draw()?;
+        let integrators = distinct(self.rows.iter().map(|r| r.integrator.as_str()));
+        let backends = distinct(self.rows.iter().map(|r| r.backend.as_str()));
+        chart.draw_series(drops.iter().map(|(r, s, e)| {
+            let k = integrators.iter().position(|i| *i == r.integrator).unwrap_or(0);
+            let m = backends.iter().position(|b| *b == r.backend).unwrap_or(0);
+            let y = if *e > 0.0 { *e } else { y_lo * 1.3 };
+            marker(m, (*s, y), style::SERIES[k % style::SERIES.len()])
+        }))?;
+        for (_, s, e) in drops.iter().filter(|d| d.0.is_default) {
+            let y = if *e > 0.0 { *e } else { y_lo * 1.3 };
+            chart.plotting_area().draw(&Circle::new((*s, y), 15, BLACK.stroke_width(3)))?;
+        }
+        Ok(())
+    }
+}
+
+impl Chart for SpeedAccuracy {
+    fn size(&self) -> (u32, u32) {
+        if self.drop_errors().is_empty() { (1200, 820) } else { (1200, 1160) }
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let ok: Vec<(&SpeedAccuracyRow, f64, f64)> =
+            self.rows.iter().filter_map(|r| plottable(r).map(|(s, e)| (r, s, e))).collect();
+        let speeds = self.rows.iter().filter_map(|r| r.sim_s_per_wall_s).filter(|s| s.is_finite() && *s > 0.0);
+        let (s_lo, s_hi) = speeds.fold((f64::INFINITY, 0.0f64), |(a, b), s| (a.min(s), b.max(s)));
+        let (s_lo, s_hi) = if s_lo.is_finite() { (s_lo, s_hi) } else { (0.1, 10.0) };
+        let (e_lo, e_hi) = ok.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.2), b.max(p.2)));
+        let (e_lo, e_hi) = if e_lo.is_finite() { (e_lo, e_hi) } else { (1e-3, 1.0) };
+        // Room below for the reference (zero error) and above for failed runs.
+        let (y_lo, y_hi) = (e_lo / 4.0, e_hi * 4.0);
+        let root = root.titled("Speed against accuracy of the simulation settings", (FONT, style::TITLE))?;
+        let drops = self.drop_errors();
+        let (top, bottom) = if drops.is_empty() {
+            (root.clone(), None)
+        } else {
+            let (_, h) = root.dim_in_pixel();
+            let (a, b) = root.split_vertically(h - 330);
+            (a, Some(b))
+        };
+        if let Some(area) = &bottom {
+            self.draw_drop_panel(area, &drops, (s_lo / 2.0)..(s_hi * 2.0))?;
+        }
+        let mut chart = ChartBuilder::on(&top)
+            .margin(16)
+            .margin_right(30)
+            .x_label_area_size(56)
+            .y_label_area_size(80)
+            .build_cartesian_2d(((s_lo / 2.0)..(s_hi * 2.0)).log_scale(), (y_lo..y_hi).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("speed [simulated s per wall-clock s] (log)")
+            .y_desc("sensor-force RMSE against the reference [N] (log)")
+            .axis_desc_style((FONT, style::AXIS))
+            .label_style((FONT, style::LABEL))
+            .x_label_formatter(&|v| style::num(*v))
+            .y_label_formatter(&|v| style::num(*v))
+            .draw()?;
+
+        let front = pareto_front(&self.rows);
+        let front_pts: Vec<(f64, f64)> = front.iter().filter_map(|i| plottable(&self.rows[*i])).collect();
+        chart
+            .draw_series(LineSeries::new(front_pts.clone(), RGBColor(60, 60, 60).stroke_width(2)))?
+            .label("Pareto front")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(60, 60, 60).stroke_width(2)));
+
+        let integrators = distinct(self.rows.iter().map(|r| r.integrator.as_str()));
+        let backends = distinct(self.rows.iter().map(|r| r.backend.as_str()));
+        for (k, integrator) in integrators.iter().enumerate() {
+            let color = style::SERIES[k % style::SERIES.len()];
+            for (m, backend) in backends.iter().enumerate() {
+                let pts: Vec<(f64, f64)> = ok
+                    .iter()
+                    .filter(|(r, _, _)| r.integrator == *integrator && r.backend == *backend)
+                    .map(|(_, s, e)| (*s, *e))
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                let label =
+                    if backends.len() > 1 { format!("{backend} / {integrator}") } else { integrator.to_string() };
+                chart
+                    .draw_series(pts.into_iter().map(move |p| marker(m, p, color)))?
+                    .label(label)
+                    .legend(move |(x, y)| marker_px(m, (x + 10, y), color));
+            }
+        }
+
+        // Failed settings along the top edge, at their speed.
+        let failed: Vec<f64> = self
+            .rows
+            .iter()
+            .filter(|r| r.status != "ok")
+            .filter_map(|r| r.sim_s_per_wall_s)
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .collect();
+        if !failed.is_empty() {
+            let y = y_hi / 1.5;
+            chart
+                .draw_series(failed.iter().map(|s| Cross::new((*s, y), 7, style::BAD.stroke_width(2))))?
+                .label("diverged / error (drawn at the top)")
+                .legend(|(x, y)| Cross::new((x + 10, y), 6, style::BAD.stroke_width(2)));
+        }
+
+        let note = |text: String, at: (f64, f64), v: VPos| -> DrawResult {
+            let font = TextStyle::from((FONT, style::SMALL).into_font()).pos(Pos::new(HPos::Left, v));
+            chart.plotting_area().draw(&Text::new(text, at, font))?;
+            Ok(())
+        };
+        for i in &front {
+            let r = &self.rows[*i];
+            if r.is_default {
+                continue; // labelled below as the default
+            }
+            if let Some((s, e)) = plottable(r) {
+                note(format!("  {}", settings(r)), (s * 1.08, e), VPos::Top)?;
+            }
+        }
+        for r in self.rows.iter().filter(|r| r.is_reference) {
+            let Some(s) = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0) else { continue };
+            // The reference has zero error against itself; it sits on the bottom edge then.
+            let e = plottable(r).map_or(y_lo * 1.4, |p| p.1);
+            chart.plotting_area().draw(&TriangleMarker::new((s, e), 10, BLACK.filled()))?;
+            let zero = if plottable(r).is_none() { ", zero error by definition" } else { "" };
+            let text = format!("  reference: {} ({}){zero}", settings(r), r.integrator);
+            note(text, (s * 1.05, e), VPos::Center)?;
+        }
+        for r in self.rows.iter().filter(|r| r.is_default) {
+            if let Some((s, e)) = plottable(r) {
+                chart.plotting_area().draw(&Circle::new((s, e), 15, BLACK.stroke_width(3)))?;
+                note(format!("  default: {} ({})", settings(r), r.integrator), (s * 1.12, e), VPos::Bottom)?;
+            }
+        }
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+            .label("default settings (ringed)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 8, BLACK.stroke_width(2)));
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+            .label("reference run (triangle)")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 8, BLACK.filled()));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, style::LABEL))
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .draw()?;
+        Ok(())
+    }
+}
+
+/// The marker of backend number `m` at a data point.
+fn marker<DB: DrawingBackend>(m: usize, at: (f64, f64), color: RGBColor) -> DynElement<'static, DB, (f64, f64)> {
+    match m % 3 {
+        0 => Circle::new(at, 6, color.filled()).into_dyn(),
+        1 => TriangleMarker::new(at, 7, color.filled()).into_dyn(),
+        _ => Cross::new(at, 6, color.stroke_width(3)).into_dyn(),
+    }
+}
+
+/// The same marker in the legend (pixel coordinates).
+fn marker_px<DB: DrawingBackend>(m: usize, at: (i32, i32), color: RGBColor) -> DynElement<'static, DB, (i32, i32)> {
+    match m % 3 {
+        0 => Circle::new(at, 6, color.filled()).into_dyn(),
+        1 => TriangleMarker::new(at, 7, color.filled()).into_dyn(),
+        _ => Cross::new(at, 6, color.stroke_width(3)).into_dyn(),
+    }
+}
