@@ -1,0 +1,51 @@
+//! `tendril run`.
+
+use super::emit;
+use crate::run::execute::run_on_twin;
+use crate::run::scenario::PickPlaceScenario;
+use crate::run::summary::render_text;
+use crate::scenario::Override;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `tendril run`.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// The scenario file (scenarios/crimper.toml, ...).
+    scenario: PathBuf,
+    /// Output folder [default: out/<scenario name>].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Seed of the sensor noise (same scenario and seed: identical trace).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Keep force control on while the arm moves (`on`) or switch it off before (`off`).
+    #[arg(long, value_parser = ["on", "off"])]
+    feedback: Option<String>,
+    /// Override a scenario value: `--set key.path=value` (repeatable), checked like the file.
+    #[arg(long = "set")]
+    set: Vec<Override>,
+}
+
+impl RunArgs {
+    /// `--seed` and `--feedback` are overrides like any `--set`, so they are validated alike.
+    fn overrides(&self) -> Vec<Override> {
+        let mut o = self.set.clone();
+        if let Some(seed) = self.seed {
+            o.push(Override { key: "seed".into(), value: toml::Value::Integer(seed as i64) });
+        }
+        if let Some(f) = &self.feedback {
+            o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
+        }
+        o
+    }
+}
+
+pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
+    let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.overrides())?;
+    let dir = a.out.clone().unwrap_or_else(|| Path::new("out").join(&scenario.name));
+    let (summary, _) = run_on_twin(&scenario, &Default::default(), Some(&dir))?;
+    emit(&render_text(&summary));
+    emit(&format!("wrote {0}/trace.csv and {0}/summary.json\n", dir.display()));
+    Ok(if summary.outcome == "error" { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}

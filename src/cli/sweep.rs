@@ -1,0 +1,69 @@
+//! `tendril sweep` and `tendril merge`.
+
+use super::emit;
+use crate::sweep::execute::{SweepOptions, run_sweep};
+use crate::sweep::{Shard, load_sweep};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `tendril sweep`.
+#[derive(Debug, clap::Args)]
+pub struct SweepArgs {
+    /// The sweep file (scenarios/sweep-gains.toml, ...).
+    sweep: PathBuf,
+    /// Output folder [default: out/<sweep file name>].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Run only slice K of N (`--shard 2/8`), for a cluster's job array.
+    #[arg(long)]
+    shard: Option<Shard>,
+    /// Skip the runs already in the results file and append the rest.
+    #[arg(long)]
+    resume: bool,
+}
+
+/// Arguments of `tendril merge`.
+#[derive(Debug, clap::Args)]
+pub struct MergeArgs {
+    /// The merged file to write.
+    #[arg(long)]
+    out: PathBuf,
+    /// The shard files (results-K-of-N.csv).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+}
+
+pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
+    let sweep = load_sweep(&a.sweep)?;
+    let stem = a.sweep.file_stem().map_or("sweep".into(), |s| s.to_string_lossy().to_string());
+    let options = SweepOptions {
+        out_dir: a.out.unwrap_or_else(|| PathBuf::from("out").join(stem)),
+        threads: a.threads,
+        shard: a.shard,
+        resume: a.resume,
+    };
+    let stats = run_sweep(&sweep, &options)?;
+    emit(&format!(
+        "{} runs in this sweep{}: {} run now ({} errors), {} already done; {:.0} simulated s in {:.1} s wall ({:.0}x real time)\nwrote {}\n",
+        stats.planned,
+        a.shard.map_or(String::new(), |s| format!(" shard {}/{}", s.index, s.count)),
+        stats.ran,
+        stats.errors,
+        stats.skipped,
+        stats.sim_time_s,
+        stats.wall_time_s,
+        stats.sim_time_s / stats.wall_time_s.max(1e-9),
+        stats.results.display()
+    ));
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn merge(a: MergeArgs) -> anyhow::Result<ExitCode> {
+    let inputs: Vec<&std::path::Path> = a.inputs.iter().map(|p| p.as_path()).collect();
+    let n = crate::sweep::results::merge(&inputs, &a.out)?;
+    emit(&format!("merged {} rows from {} files into {}\n", n, inputs.len(), a.out.display()));
+    Ok(ExitCode::SUCCESS)
+}
