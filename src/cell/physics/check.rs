@@ -149,3 +149,31 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{ScenarioError, from_str};
+    use std::path::Path;
+
+    fn load(text: &str) -> Result<CheckScenario, ScenarioError> {
+        from_str(text, Path::new("t.toml"), &[])
+    }
+
+    #[test]
+    fn sections_parse_with_defaults_and_reject_bad_keys() {
+        let s =
+            load("[physics]\ntimestep_s = 0.002\ncone = \"pyramidal\"\n[object]\nname = \"hammer\"\nfriction = 0.6\n")
+                .unwrap();
+        assert_eq!(s.physics.timestep_s, 0.002);
+        assert_eq!(s.physics.cone, super::super::Cone::Pyramidal);
+        assert_eq!(s.object.name, super::super::ObjectName::Hammer);
+        assert_eq!(s.finger, FingerConfig::default());
+        let err = load("[finger]\nrelaxed_fraction = 1.5\n").unwrap_err().to_string();
+        assert!(err.contains("finger.relaxed_fraction"), "{err}");
+        let err = load("[physics]\ntimestep = 0.002\n").unwrap_err().to_string();
+        assert!(err.contains("timestep"), "{err}");
+        let err = load("[object]\nname = \"spoon\"\n").unwrap_err().to_string();
+        assert!(err.contains("object.name"), "{err}");
+    }
+}
