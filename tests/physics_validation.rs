@@ -248,6 +248,31 @@ fn same_inputs_give_bit_identical_trajectories() {
 }
 
 #[test]
+fn runs_sharing_one_model_across_threads_match_a_sequential_run() {
+    let shared = SceneModel::build(&SceneSpec::default()).unwrap();
+    let run = |shared: std::sync::Arc<SceneModel>| {
+        let mut s = Scene::new(shared);
+        s.set_growth(0.14).unwrap();
+        s.run_for(3.5).unwrap();
+        s.set_twine(0.01).unwrap();
+        s.run_for(1.0).unwrap();
+        s.data().qpos().to_vec()
+    };
+    let sequential = run(shared.clone());
+    let threads: Vec<_> = (0..2)
+        .map(|_| {
+            std::thread::spawn({
+                let shared = shared.clone();
+                move || run(shared)
+            })
+        })
+        .collect();
+    for t in threads {
+        assert_eq!(t.join().unwrap(), sequential);
+    }
+}
+
+#[test]
 fn an_unstable_setting_is_reported_with_its_time() {
     // Euler at 20 ms with an undamped, very stiff motor servo: omega * dt = sqrt(kp / m) * dt = 45,
     // far beyond the explicit stability limit of 2. The strip is flung through the guide.
