@@ -31,9 +31,9 @@ pub enum Cone {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ArmMode {
-    /// Prescribed arm motion: each step the six joints are set to the commanded angles (rate-limited
-    /// to `arm_max_speed_rad_s`) with the matching joint velocities, so the hand moves exactly along the
-    /// UR's trajectory and has the velocity friction needs (a mocap body would have none). The joints
+    /// Prescribed arm motion: each step the six joints get the velocities that take them to the
+    /// commanded angles (rate-limited to `arm_max_speed_rad_s`), so the hand moves along the UR's
+    /// trajectory and has the velocity friction needs (a mocap body would have none). The joints
     /// carry a large armature so contact forces do not move the arm within a step. The UR's own servo
     /// loop is stiff enough that the real hand follows its trajectory too. Cheapest (no servos).
     Kinematic,
