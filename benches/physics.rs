@@ -11,13 +11,13 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 use tendril::cell::physics::{ArmMode, PhysicsConfig, Scene, SceneSpec, ur5e, validation};
 
-/// A scene already holding the object: grown (3.5 s at the motor's speed), twined to 32 mm (1 s),
-/// settled (0.5 s).
+/// A scene already holding the object: grown (3.5 s at the motor's speed), twined to 32 mm at a steady
+/// 7.5 mm/s (4.3 s), settled (0.5 s).
 fn grasped(spec: &SceneSpec) -> Scene {
     let mut s = Scene::build(spec).expect("scene builds");
     s.set_growth(spec.finger.length_m).unwrap();
     s.run_for(3.5).unwrap();
-    let n = (1.0 / s.timestep()).round() as usize;
+    let n = (0.032 / 0.0075 / s.timestep()).round() as usize;
     for k in 1..=n {
         s.set_twine(0.032 * k as f64 / n as f64).unwrap();
         s.step().unwrap();

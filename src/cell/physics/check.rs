@@ -44,6 +44,9 @@ pub struct CheckScript {
     pub pad_setpoint_n: f64,
     /// Gain of that loop [m of tendon per N per s].
     pub loop_gain_m_per_n_s: f64,
+    /// Stop the loop when the lift starts and hold the twine there (the paper's "without feedback"
+    /// runs: grasp to the setpoint, then move with the motor position fixed).
+    pub freeze_at_lift: bool,
 }
 
 impl Default for CheckScript {
@@ -59,6 +62,7 @@ impl Default for CheckScript {
             print_every_s: 0.25,
             pad_setpoint_n: 0.0,
             loop_gain_m_per_n_s: 0.002,
+            freeze_at_lift: false,
         }
     }
 }
@@ -106,10 +110,11 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
     let mut twine = 0.0;
     while scene.time() < end {
         let t = scene.time();
-        if c.pad_setpoint_n > 0.0 && t > t_twine + t_wind {
+        let frozen = c.freeze_at_lift && t >= t_lift;
+        if c.pad_setpoint_n > 0.0 && t > t_twine + t_wind && !frozen {
             let error = c.pad_setpoint_n - scene.readout().pad_force_n;
             twine += c.loop_gain_m_per_n_s * error * scene.timestep();
-        } else {
+        } else if c.pad_setpoint_n == 0.0 {
             twine = c.twine_m * ((t - t_twine) / t_wind).clamp(0.0, 1.0);
         }
         scene.set_twine(twine)?;
@@ -148,4 +153,32 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{ScenarioError, from_str};
+    use std::path::Path;
+
+    fn load(text: &str) -> Result<CheckScenario, ScenarioError> {
+        from_str(text, Path::new("t.toml"), &[])
+    }
+
+    #[test]
+    fn sections_parse_with_defaults_and_reject_bad_keys() {
+        let s =
+            load("[physics]\ntimestep_s = 0.002\ncone = \"pyramidal\"\n[object]\nname = \"hammer\"\nfriction = 0.6\n")
+                .unwrap();
+        assert_eq!(s.physics.timestep_s, 0.002);
+        assert_eq!(s.physics.cone, super::super::Cone::Pyramidal);
+        assert_eq!(s.object.name, super::super::ObjectName::Hammer);
+        assert_eq!(s.finger, FingerConfig::default());
+        let err = load("[finger]\nrelaxed_fraction = 1.5\n").unwrap_err().to_string();
+        assert!(err.contains("finger.relaxed_fraction"), "{err}");
+        let err = load("[physics]\ntimestep = 0.002\n").unwrap_err().to_string();
+        assert!(err.contains("timestep"), "{err}");
+        let err = load("[object]\nname = \"spoon\"\n").unwrap_err().to_string();
+        assert!(err.contains("object.name"), "{err}");
+    }
 }

@@ -31,9 +31,9 @@ pub enum Cone {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ArmMode {
-    /// Prescribed arm motion: each step the six joints are set to the commanded angles (rate-limited
-    /// to `arm_max_speed_rad_s`) with the matching joint velocities, so the hand moves exactly along the
-    /// UR's trajectory and has the velocity friction needs (a mocap body would have none). The joints
+    /// Prescribed arm motion: each step the six joints get the velocities that take them to the
+    /// commanded angles (rate-limited to `arm_max_speed_rad_s`), so the hand moves along the UR's
+    /// trajectory and has the velocity friction needs (a mocap body would have none). The joints
     /// carry a large armature so contact forces do not move the arm within a step. The UR's own servo
     /// loop is stiff enough that the real hand follows its trajectory too. Cheapest (no servos).
     Kinematic,
@@ -45,13 +45,13 @@ pub enum ArmMode {
 ///
 /// Defaults follow MuJoCo's advice for slip accuracy (elliptic cones, large impratio, Newton solver with
 /// a small tolerance, then noslip iterations; modeling.md measured that pyramidal cones creep and a held
-/// box creeps without noslip) at the largest step that passes tests/physics_validation.rs and keeps the
-/// full scene above 100x real time (benches/physics.rs).
+/// box creeps without noslip) at the largest step that passes tests/physics_validation.rs, chosen for
+/// the full scene's speed (~100x real time, benches/physics.rs; models/README.md has the figures).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
-    /// Simulation step [s]. 2 ms: contact time constants down to 4 ms stay resolvable (MuJoCo needs
-    /// solref time constant >= 2 steps) and the finger's stiffest mode is resolved.
+    /// Simulation step [s]. 5 ms: the largest step at which the contact time constant (10 ms) is still
+    /// two steps (MuJoCo's minimum) and the pinch bound holds to 0.02 %; 2 ms runs ~2.5x slower.
     pub timestep_s: f64,
     /// Integrator. `implicitfast`: the creep dashpot (thousands of N s/m on a 1 g node) and the servos'
     /// `kv` are integrated implicitly, which explicit Euler would not survive at this step.
@@ -63,17 +63,21 @@ pub struct PhysicsConfig {
     pub impratio: f64,
     /// Newton solver iterations (upper bound; it usually converges in 2-5).
     pub iterations: u32,
-    /// Solver tolerance (relative cost improvement). Small so friction is converged.
+    /// Solver tolerance (relative cost improvement). 1e-8: friction converged; tighter costs time for
+    /// no measurable change in the validation results.
     pub tolerance: f64,
-    /// Line-search iterations of the Newton solver.
+    /// Line-search iterations of the Newton solver. 20: with 5 the object sank 14 mm into the table
+    /// during a grasp (measured).
     pub ls_iterations: u32,
-    /// Post-solve no-slip iterations. 4: removes the residual tangential creep of soft contacts
-    /// (modeling.md: a held box crept ~1 mm/s until noslip was added).
+    /// Post-solve no-slip iterations. 10: removes the residual tangential creep of soft contacts
+    /// (modeling.md: a held box crept ~1 mm/s until noslip was added); at 5 ms, 0 or 4 iterations left
+    /// the pinch holding force 6-8 % above m(g+a)/2mu, 10 gives 0.02 %. About a third of a step's time.
     pub noslip_iterations: u32,
     /// No-slip solver tolerance.
     pub noslip_tolerance: f64,
-    /// Contact solref time constant [s] (global default): stiffness of contacts. 0.01 s: at least 5 steps
-    /// at the default step (MuJoCo recommends >= 2), stiff enough that the finger sinks < 1 mm.
+    /// Contact solref time constant [s] (global default): stiffness of contacts. 0.01 s: two steps at the
+    /// default step (MuJoCo's minimum; it clamps shorter ones); with the finger's armature the strip
+    /// sinks about 1 mm into the objects.
     pub contact_timeconst_s: f64,
     /// Contact solref damping ratio (1 = critical).
     pub contact_dampratio: f64,
@@ -144,8 +148,9 @@ impl Validate for PhysicsConfig {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FingerConfig {
-    /// Number of strip segments (discretisation). 10: 14 mm segments, a 12 mm pad fits on one and a
-    /// 12.5 mm-radius handle is wrapped by ~6 segments.
+    /// Number of strip segments (discretisation). 8: 17.5 mm segments, the 12 mm pad fits on one and a
+    /// 12.5 mm-radius handle is wrapped by ~4.5 segments per turn. 12 or 16 did not change the pad's
+    /// share of the force and cost speed.
     pub segments: u32,
     /// Strip length that can be grown out of the guide [m]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,

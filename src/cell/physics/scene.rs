@@ -327,14 +327,14 @@ impl Scene {
             *ctrl += (target - *ctrl).clamp(-max, max);
         }
         if self.shared.ids.arm_act.is_none() {
-            // Prescribed motion: this step's start angles and the velocity that reaches the next ones.
+            // Prescribed motion: the joint velocity that takes the actual angles to the next commanded
+            // ones in this step (so nothing drifts). Writing qpos directly instead doubled the step time.
             let dt = self.timestep();
             let max = self.shared.spec.physics.arm_max_speed_rad_s * dt;
             for k in 0..6 {
-                let step = (self.arm_target[k] - self.arm_q[k]).clamp(-max, max);
-                self.data.qpos_mut()[ids.arm_qpos[k]] = self.arm_q[k];
-                self.data.qvel_mut()[ids.arm_dof[k]] = step / dt;
-                self.arm_q[k] += step;
+                self.arm_q[k] += (self.arm_target[k] - self.arm_q[k]).clamp(-max, max);
+                let actual = self.data.qpos()[ids.arm_qpos[k]];
+                self.data.qvel_mut()[ids.arm_dof[k]] = (self.arm_q[k] - actual) / dt;
             }
         }
         self.data.step();
