@@ -29,4 +29,5 @@ pub mod run;
 pub mod scenario;
 pub mod sensor_bench;
 pub mod signals;
+pub mod study;
 pub mod sweep;

@@ -1,5 +1,6 @@
 //! Command-line interface: one file per command group, each with its arguments and handler.
 
+mod chart;
 mod physics;
 mod plot;
 mod reproduce;
@@ -34,6 +35,9 @@ enum Command {
     /// Draw charts (PNG and SVG): a run directory's force trace, a sweep directory's heatmaps, or
     /// the charts of speed_accuracy.csv, stability.csv and gain_map.csv (a file or its folder).
     Plot(plot::PlotArgs),
+    /// Run a study over many runs and chart it: speed against accuracy, stability limits of the
+    /// integrators, or the (Kp, Ki) map of each object.
+    Chart(chart::ChartArgs),
     /// Run the paper's calibration procedures on a bench CSV (columns: time_s, load_cell_n,
     /// fbg1_nm, fbg2_nm, temperature_c) and print the results.
     Calibrate(sensor::CalibrateArgs),
@@ -52,6 +56,7 @@ pub fn main() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Merge(a) => sweep::merge(a),
         Command::Plot(a) => plot::run(a),
+        Command::Chart(a) => chart::run(a),
         Command::Calibrate(a) => sensor::calibrate(a),
         Command::Bench(a) => sensor::bench(a),
         Command::PhysicsCheck(a) => physics::run(a),

@@ -17,6 +17,35 @@ pub struct ControlMetrics {
     pub min_moving_force_n: Option<f64>,
     /// RMS of estimate − true force from the grasp to the release [N] (None without ground truth).
     pub force_rmse_n: Option<f64>,
+    /// Whether the loop oscillates on its own: during the grasp (arm still), after first
+    /// reaching 90 % of the setpoint, the estimate swings across a ±10 % band around the
+    /// setpoint at least [`OSCILLATION_SWINGS`] times.
+    pub oscillating: bool,
+}
+
+/// Swings across the ±10 % band that make a grasp count as oscillating: two full periods.
+pub const OSCILLATION_SWINGS: usize = 4;
+
+/// Counts alternations between above +10 % and below −10 % of the setpoint.
+fn band_swings(rows: &[&TraceRow]) -> usize {
+    let mut last: Option<bool> = None;
+    let mut swings = 0;
+    for r in rows {
+        let side = if r.force_n > 1.1 * r.setpoint_n {
+            Some(true)
+        } else if r.force_n < 0.9 * r.setpoint_n {
+            Some(false)
+        } else {
+            None
+        };
+        if let Some(side) = side {
+            if last.is_some_and(|l| l != side) {
+                swings += 1;
+            }
+            last = Some(side);
+        }
+    }
+    swings
 }
 
 /// Computes [`ControlMetrics`] from a run's rows. `drop_time_s` bounds the moving window: ticks
@@ -38,7 +67,9 @@ pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMe
         .map(|r| (r.force_n - r.true_force_n).powi(2))
         .collect();
     let force_rmse_n = (!compared.is_empty()).then(|| (compared.iter().sum::<f64>() / compared.len() as f64).sqrt());
-    ControlMetrics { rise_time_90_s, overshoot_pct, max_fluctuation_pct, min_moving_force_n, force_rmse_n }
+    let settled: Vec<&TraceRow> = grasp.iter().copied().skip_while(|r| r.force_n < 0.9 * r.setpoint_n).collect();
+    let oscillating = band_swings(&settled) >= OSCILLATION_SWINGS;
+    ControlMetrics { rise_time_90_s, overshoot_pct, max_fluctuation_pct, min_moving_force_n, force_rmse_n, oscillating }
 }
 
 #[cfg(test)]
@@ -81,5 +112,20 @@ mod tests {
         assert!((m.max_fluctuation_pct.unwrap() - 25.0).abs() < 1e-9);
         assert!((m.force_rmse_n.unwrap() - 0.01).abs() < 1e-9);
         assert_eq!(control_metrics(&rows, Some(20.05)).max_fluctuation_pct, None);
+        assert!(!m.oscillating);
+    }
+
+    #[test]
+    fn a_grasp_swinging_across_the_band_oscillates() {
+        let swinging: Vec<TraceRow> =
+            (0..500).map(|i| row(i as f64 * 0.01, Phase::Grasp, 1.0 + 0.3 * (i as f64 * 0.1).sin())).collect();
+        assert!(control_metrics(&swinging, None).oscillating);
+        let damped: Vec<TraceRow> = (0..500)
+            .map(|i| {
+                let t = i as f64 * 0.01;
+                row(t, Phase::Grasp, 1.0 + 0.3 * (-t).exp() * (t * 10.0).sin())
+            })
+            .collect();
+        assert!(!control_metrics(&damped, None).oscillating);
     }
 }

@@ -50,6 +50,8 @@ pub struct RunSummary {
     pub min_moving_force_n: Option<f64>,
     /// RMS error of the estimate against the true force while holding [N].
     pub force_rmse_n: Option<f64>,
+    /// Whether the grasp oscillated on its own (see `run::metrics`).
+    pub oscillating: bool,
     /// Simulated (or cell) time covered [s].
     pub sim_time_s: f64,
     /// Wall-clock time of the run [s].
@@ -122,6 +124,7 @@ impl RunSummary {
             max_fluctuation_pct: report.metrics.max_fluctuation_pct,
             min_moving_force_n: report.metrics.min_moving_force_n,
             force_rmse_n: report.metrics.force_rmse_n,
+            oscillating: report.metrics.oscillating,
             sim_time_s: report.cell_time_s,
             wall_time_s,
             real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },

@@ -1,0 +1,81 @@
+//! Studies over many runs: speed against accuracy, stability limits, gain maps.
+//!
+//! Each study loads one scenario with overrides per run, runs it on the twin, writes a CSV and
+//! draws its chart with [`crate::plot`].
+//!
+//! - [`speed_accuracy`]: timestep × integrator × cone × finger links against a fine reference.
+//! - [`stability`]: the largest stable timestep per integrator, and what fails past it.
+//! - [`gain_map`]: where in (Kp, Ki) the loop oscillates or loses the object, per object.
+
+pub mod gain_map;
+pub mod speed_accuracy;
+pub mod stability;
+
+use crate::run::execute::{ModelCache, run_on_twin};
+use crate::run::runner::RunReport;
+use crate::run::scenario::PickPlaceScenario;
+use crate::run::summary::RunSummary;
+use crate::scenario::Override;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// `key=value` as an override (the value parsed as TOML, like `--set`).
+pub fn set(key: &str, value: impl std::fmt::Display) -> Override {
+    format!("{key}={value}").parse().expect("study keys and values are well formed")
+}
+
+/// One run of a study: its overrides and what came of it.
+pub struct StudyRun {
+    /// Overrides on the study's scenario.
+    pub overrides: Vec<Override>,
+    /// The summary (outcome "error" with the cause when the run could not start).
+    pub summary: RunSummary,
+    /// The run's ticks, when it ran.
+    pub report: Option<RunReport>,
+}
+
+/// Loads `scenario` with each override set and runs them on `threads` workers (1 for timing
+/// studies, so runs do not compete for cores). Bad keys or values fail before anything runs.
+pub fn run_all(scenario: &Path, sets: Vec<Vec<Override>>, threads: usize) -> anyhow::Result<Vec<StudyRun>> {
+    let scenarios: Vec<PickPlaceScenario> =
+        sets.iter().map(|o| crate::scenario::load(scenario, o)).collect::<Result<_, _>>()?;
+    let models = ModelCache::default();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+    let progress = indicatif::ProgressBar::new(sets.len() as u64);
+    let runs = pool.install(|| {
+        scenarios
+            .par_iter()
+            .zip(sets)
+            .map(|(s, overrides)| {
+                let run = match run_on_twin(s, &models, None) {
+                    Ok((summary, report)) => StudyRun { overrides, summary, report: Some(report) },
+                    Err(e) => StudyRun {
+                        overrides,
+                        summary: RunSummary::failed_to_start(&s.name, format!("{e:#}")),
+                        report: None,
+                    },
+                };
+                progress.inc(1);
+                run
+            })
+            .collect()
+    });
+    progress.finish_and_clear();
+    Ok(runs)
+}
+
+/// Writes a CSV of string cells, naming the file in the error.
+pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<String>]) -> anyhow::Result<()> {
+    let err = |e: csv::Error| anyhow::anyhow!("{}: {e}", path.display());
+    let mut w = csv::Writer::from_path(path).map_err(err)?;
+    w.write_record(header).map_err(err)?;
+    for r in rows {
+        w.write_record(r).map_err(err)?;
+    }
+    w.flush().map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// Text of an optional number for a CSV cell (empty when absent).
+pub fn cell(v: Option<f64>) -> String {
+    v.map_or(String::new(), |v| format!("{v}"))
+}

@@ -1,0 +1,159 @@
+//! Speed against accuracy: one scenario over timestep × integrator × friction cone × finger
+//! links, each compared with a reference run (smallest timestep, finest finger).
+//!
+//! Accuracy is the RMS difference of the true sensor-force trace from the reference's, tick by
+//! tick while the object should be held, and the drop-time difference. Speed is simulated
+//! seconds per wall second, with runs one at a time so they do not share cores.
+
+use super::{StudyRun, cell, run_all, set, write_csv};
+use crate::plot::speed_accuracy::{SpeedAccuracyRow, render};
+use std::path::{Path, PathBuf};
+
+/// The grid of a speed/accuracy study.
+#[derive(Debug, Clone)]
+pub struct Grid {
+    /// Timesteps [s].
+    pub timesteps_s: Vec<f64>,
+    /// Integrators (`euler`, `implicitfast`, `implicit`, `rk4`).
+    pub integrators: Vec<&'static str>,
+    /// Friction cones (`pyramidal`, `elliptic`).
+    pub cones: Vec<&'static str>,
+    /// Finger links.
+    pub segments: Vec<u32>,
+    /// The reference: timestep [s] and links (implicit integrator, elliptic cone).
+    pub reference: (f64, u32),
+}
+
+impl Grid {
+    /// The full study (about a hundred runs).
+    pub fn full() -> Grid {
+        Grid {
+            timesteps_s: vec![0.001, 0.002, 0.005, 0.01],
+            integrators: vec!["euler", "implicitfast", "implicit", "rk4"],
+            cones: vec!["pyramidal", "elliptic"],
+            segments: vec![6, 8, 12],
+            reference: (0.0005, 16),
+        }
+    }
+
+    /// A small grid for a quick look (and the tests).
+    pub fn quick() -> Grid {
+        Grid {
+            timesteps_s: vec![0.002, 0.005],
+            integrators: vec!["implicitfast", "euler"],
+            cones: vec!["elliptic"],
+            segments: vec![8],
+            reference: (0.001, 12),
+        }
+    }
+}
+
+fn settings(dt: f64, integrator: &str, cone: &str, segments: u32) -> Vec<crate::scenario::Override> {
+    vec![
+        set("physics.timestep_s", dt),
+        set("physics.integrator", format!("\"{integrator}\"")),
+        set("physics.cone", format!("\"{cone}\"")),
+        set("finger.segments", segments),
+    ]
+}
+
+/// RMS difference of two runs' true sensor force over the ticks both have in holding phases.
+fn trace_rmse(run: &StudyRun, reference: &StudyRun) -> Option<f64> {
+    let (a, b) = (&run.report.as_ref()?.rows, &reference.report.as_ref()?.rows);
+    let diffs: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| x.phase.holding() && y.phase.holding())
+        .map(|(x, y)| (x.true_force_n - y.true_force_n).powi(2))
+        .filter(|d| d.is_finite())
+        .collect();
+    (!diffs.is_empty()).then(|| (diffs.iter().sum::<f64>() / diffs.len() as f64).sqrt())
+}
+
+/// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`.
+/// `defaults` names the project's default settings (timestep, integrator, cone, links) to
+/// highlight. Returns the files written.
+pub fn run(scenario: &Path, grid: &Grid, defaults: (f64, &str, &str, u32), out: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let mut sets = vec![settings(grid.reference.0, "implicit", "elliptic", grid.reference.1)];
+    let mut labels = vec![(grid.reference.0, "implicit", "elliptic", grid.reference.1)];
+    for &dt in &grid.timesteps_s {
+        for &integrator in &grid.integrators {
+            for &cone in &grid.cones {
+                for &segments in &grid.segments {
+                    sets.push(settings(dt, integrator, cone, segments));
+                    labels.push((dt, integrator, cone, segments));
+                }
+            }
+        }
+    }
+    let runs = run_all(scenario, sets, 1)?;
+    let reference = &runs[0];
+    let rows: Vec<SpeedAccuracyRow> = runs
+        .iter()
+        .zip(&labels)
+        .enumerate()
+        .map(|(i, (r, &(dt, integrator, cone, segments)))| {
+            let ok = r.summary.outcome != "error";
+            let drop_error = match (r.summary.drop_time_s, reference.summary.drop_time_s) {
+                (Some(a), Some(b)) => Some((a - b).abs()),
+                _ => None,
+            };
+            SpeedAccuracyRow {
+                backend: r.summary.backend.clone(),
+                integrator: integrator.into(),
+                cone: cone.into(),
+                timestep_s: dt,
+                segments,
+                sim_s_per_wall_s: ok.then_some(r.summary.real_time_factor),
+                force_rmse_n: if i == 0 {
+                    Some(0.0)
+                } else if ok {
+                    trace_rmse(r, reference)
+                } else {
+                    None
+                },
+                drop_time_error_s: if ok { drop_error } else { None },
+                status: if ok { "ok".into() } else { "diverged".into() },
+                is_default: (dt, integrator, cone, segments) == defaults && i != 0,
+                is_reference: i == 0,
+            }
+        })
+        .collect();
+    std::fs::create_dir_all(out).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
+    let csv = out.join("speed_accuracy.csv");
+    let header = [
+        "backend",
+        "integrator",
+        "cone",
+        "timestep_s",
+        "segments",
+        "sim_s_per_wall_s",
+        "force_rmse_n",
+        "drop_time_error_s",
+        "status",
+        "is_default",
+        "is_reference",
+    ];
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.backend.clone(),
+                r.integrator.clone(),
+                r.cone.clone(),
+                r.timestep_s.to_string(),
+                r.segments.to_string(),
+                cell(r.sim_s_per_wall_s),
+                cell(r.force_rmse_n),
+                cell(r.drop_time_error_s),
+                r.status.clone(),
+                r.is_default.to_string(),
+                r.is_reference.to_string(),
+            ]
+        })
+        .collect();
+    write_csv(&csv, &header, &cells)?;
+    let mut files = vec![csv];
+    files.extend(render(&rows, out)?);
+    Ok(files)
+}

@@ -1,0 +1,66 @@
+//! Stability where numerical methods fail: for each integrator, the scenario at growing
+//! timesteps, classified as stable, diverged, too deep a penetration, or a lost grasp (the
+//! object dropped although the run at the project's defaults holds it).
+
+use super::{cell, run_all, set, write_csv};
+use crate::plot::stability::{StabilityRow, render};
+use std::path::{Path, PathBuf};
+
+/// Timesteps tried [s], from MuJoCo's usual 1 ms to far past anything sensible.
+pub const TIMESTEPS_S: [f64; 7] = [0.001, 0.002, 0.005, 0.01, 0.02, 0.04, 0.08];
+/// Integrators compared.
+pub const INTEGRATORS: [&str; 4] = ["euler", "implicitfast", "implicit", "rk4"];
+
+/// Runs the study on `scenario` (which should hold its object at the defaults), writes
+/// `stability.csv` and its chart into `out`. `threads` workers.
+pub fn run(scenario: &Path, timesteps: &[f64], out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
+    let mut sets = vec![vec![]];
+    let mut labels = vec![("default", 0.0)];
+    for integrator in INTEGRATORS {
+        for &dt in timesteps {
+            sets.push(vec![set("physics.timestep_s", dt), set("physics.integrator", format!("\"{integrator}\""))]);
+            labels.push((integrator, dt));
+        }
+    }
+    let runs = run_all(scenario, sets, threads)?;
+    let held_at_defaults = runs[0].summary.outcome == "held";
+    let rows: Vec<StabilityRow> = runs[1..]
+        .iter()
+        .zip(&labels[1..])
+        .map(|(r, &(integrator, dt))| {
+            let error = r.summary.error.as_deref().unwrap_or("");
+            let outcome = match r.summary.outcome.as_str() {
+                "error" if error.contains("penetrat") => "penetration",
+                "error" => "diverged",
+                "dropped" if held_at_defaults => "lost_grasp",
+                _ => "stable",
+            };
+            StabilityRow {
+                backend: r.summary.backend.clone(),
+                integrator: integrator.into(),
+                timestep_s: dt,
+                outcome: outcome.into(),
+            }
+        })
+        .collect();
+    std::fs::create_dir_all(out).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
+    let csv = out.join("stability.csv");
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .zip(&runs[1..])
+        .map(|(r, run)| {
+            vec![
+                r.backend.clone(),
+                r.integrator.clone(),
+                r.timestep_s.to_string(),
+                r.outcome.clone(),
+                cell(Some(run.summary.real_time_factor)),
+                run.summary.error.clone().unwrap_or_default(),
+            ]
+        })
+        .collect();
+    write_csv(&csv, &["backend", "integrator", "timestep_s", "outcome", "sim_s_per_wall_s", "cause"], &cells)?;
+    let mut files = vec![csv];
+    files.extend(render(&rows, out)?);
+    Ok(files)
+}
