@@ -77,7 +77,10 @@ pub fn from_table<T: DeserializeOwned + Validate>(table: toml::Table, file: &Pat
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
         let key = if path == "." { "(top level)".to_string() } else { path };
-        ScenarioError::Invalid { file: file.into(), key, reason: e.into_inner().to_string() }
+        // The TOML layer appends "in `key`" lines; the key is reported separately.
+        let message = e.into_inner().to_string();
+        let reason = message.lines().next().unwrap_or_default().trim().to_string();
+        ScenarioError::Invalid { file: file.into(), key, reason }
     })?;
     let mut checker = Checker::default();
     value.validate(&mut checker);
