@@ -1,0 +1,41 @@
+//! A full pick-and-place scenario on the twin, start to finish: physics, sensor model, estimator,
+//! controller and task sequencing (`cargo bench --bench scenario`).
+//!
+//! Criterion reports the wall time of one run; the bench also prints simulated seconds per wall
+//! second (the goal: ≥ 100× real time on one core).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::path::Path;
+use std::time::{Duration, Instant};
+use tendril::run::execute::{ModelCache, run_on_twin};
+use tendril::run::scenario::PickPlaceScenario;
+
+fn scenario(name: &str) -> PickPlaceScenario {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
+    tendril::scenario::load(&file, &[]).expect("shipped scenarios load")
+}
+
+fn full_scenario(c: &mut Criterion) {
+    let mut group = c.benchmark_group("scenario");
+    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    for name in ["crimper", "shampoo", "hammer"] {
+        let s = scenario(name);
+        let models = ModelCache::default();
+        let (summary, _) = run_on_twin(&s, &models, None).expect("runs");
+        let started = Instant::now();
+        let (again, _) = run_on_twin(&s, &models, None).expect("runs");
+        let wall = started.elapsed().as_secs_f64();
+        assert_eq!(summary.outcome, again.outcome, "deterministic");
+        println!(
+            "{name}: {:.1} simulated s in {:.3} s wall = {:.0}x real time (one core, model compiled once)",
+            again.sim_time_s,
+            wall,
+            again.sim_time_s / wall
+        );
+        group.bench_function(name, |b| b.iter(|| run_on_twin(&s, &models, None).expect("runs")));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, full_scenario);
+criterion_main!(benches);
