@@ -59,7 +59,7 @@ pub fn run_on_twin(
     let report = run_task(&mut cell, &scenario.control_plan(), trace.as_mut());
     let identity = RunIdentity {
         scenario: scenario.name.clone(),
-        object: format!("{:?}", scenario.object.name).to_lowercase(),
+        object: scenario.object.name.to_string(),
         mass_kg: scenario.object.name.paper_mass_kg(),
         feedback: scenario.feedback,
         gains: Gains { kp: scenario.controller.kp, ki: scenario.controller.ki, kd: scenario.controller.kd },

@@ -296,6 +296,17 @@ pub enum ObjectName {
     Shampoo,
 }
 
+impl std::fmt::Display for ObjectName {
+    /// The name as written in scenarios (`crimper`, `hammer`, `shampoo`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ObjectName::Crimper => "crimper",
+            ObjectName::Hammer => "hammer",
+            ObjectName::Shampoo => "shampoo",
+        })
+    }
+}
+
 impl ObjectName {
     /// The MJCF text of the object (models/objects/*.xml).
     pub fn mjcf(self) -> &'static str {
