@@ -76,15 +76,15 @@ pub fn rows(scenario_dir: &Path, overrides: &[Override]) -> anyhow::Result<Vec<R
                 tolerance: "held".into(),
                 pass: s.outcome == "held",
             });
-            let rise = s.rise_time_90_s.unwrap_or(f64::NAN);
+            let rise = s.metrics.rise_time_90_s.unwrap_or(f64::NAN);
             rows.push(Row {
-                quantity: format!("{name}, feedback: rise to 90 % of {} N [s]", s.setpoint_n),
+                quantity: format!("{name}, feedback: rise to 90 % of {} N [s]", s.run.setpoint_n),
                 paper: format!("≤ {RISE_LIMIT_S:.1} s"),
                 twin: format!("{rise:.2} s"),
                 tolerance: format!("≤ {RISE_LIMIT_S:.1} s"),
                 pass: rise <= RISE_LIMIT_S,
             });
-            let fluct = s.max_fluctuation_pct.unwrap_or(f64::NAN);
+            let fluct = s.metrics.max_fluctuation_pct.unwrap_or(f64::NAN);
             rows.push(Row {
                 quantity: format!("{name}, feedback: largest fluctuation while moving [%]"),
                 paper: format!("{:.0} %", paper.fluctuation_pct),

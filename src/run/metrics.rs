@@ -2,10 +2,10 @@
 
 use super::trace::TraceRow;
 use crate::control::task::Phase;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Closed-loop figures of one run (all from the sensor's estimate, as the paper measures).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct ControlMetrics {
     /// Time from the start of force control to the first estimate ≥ 90 % of the setpoint [s].
     pub rise_time_90_s: Option<f64>,

@@ -112,13 +112,13 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
                 cause: format!("at t = {:.3} s: {e}", state.time_s),
             })?;
             let decision = sequencer.update(&state, estimate.force_n, dt);
-            slip.update(state.time_s, estimate.force_n, unloaded_n, plan.setpoint_n, decision.phase.holding());
+            // Slip is watched while the arm carries the object, as in the paper.
+            slip.update(state.time_s, estimate.force_n, unloaded_n, plan.setpoint_n, decision.phase.arm_moving());
             cell.write(&decision.command)?;
 
             let truth = cell.ground_truth();
             if let Some(t) = truth {
-                let watching = decision.phase.holding() && decision.phase != Phase::Grasp;
-                if watching && !t.in_contact && truth_drop.is_none() {
+                if decision.phase.arm_moving() && !t.in_contact && truth_drop.is_none() {
                     let since = *no_contact_since.get_or_insert(state.time_s);
                     if state.time_s - since >= LOST_CONTACT_S {
                         truth_drop = Some(Drop { cell_time_s: since, phase: phase_at(&rows, since) });

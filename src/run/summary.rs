@@ -1,5 +1,6 @@
 //! `summary.json`: the one-record result of a run, also the row of a sweep's `results.csv`.
 
+use super::metrics::ControlMetrics;
 use super::runner::{Outcome, RunReport};
 use serde::{Deserialize, Serialize};
 
@@ -14,10 +15,9 @@ pub struct Gains {
     pub kd: f64,
 }
 
-/// The summary of one run. Times are in seconds; `drop_time_s` counts from the moment the arm
-/// started moving the object (the paper's Fig. 9 time axis), `drop_cell_time_s` from activation.
+/// What identifies a run besides its report.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct RunSummary {
+pub struct RunIdentity {
     /// Scenario name.
     pub scenario: String,
     /// Object name.
@@ -30,6 +30,20 @@ pub struct RunSummary {
     pub gains: Gains,
     /// Force setpoint [N].
     pub setpoint_n: f64,
+    /// Seed of every random process in the run.
+    pub seed: u64,
+    /// Which cell ran it ("mujoco", "real", ...).
+    pub backend: String,
+}
+
+/// The summary of one run. Times are in seconds; `drop_time_s` counts from the moment the arm
+/// started moving the object (the paper's Fig. 9 time axis), `drop_cell_time_s` from activation.
+/// The identity and the control metrics are flattened into the record (and the CSV row).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Scenario, object, gains, seed, backend.
+    #[serde(flatten)]
+    pub run: RunIdentity,
     /// "held", "dropped" or "error".
     pub outcome: String,
     /// Time of the drop after the arm started moving [s].
@@ -40,58 +54,29 @@ pub struct RunSummary {
     pub drop_phase: Option<String>,
     /// When the sensor-based detector saw slip start, after the arm started moving [s].
     pub slip_detected_s: Option<f64>,
-    /// From force control on to 90 % of the setpoint [s].
-    pub rise_time_90_s: Option<f64>,
-    /// Overshoot during the grasp [% of setpoint].
-    pub overshoot_pct: f64,
-    /// Largest |F − setpoint| / setpoint while the arm moves, held runs only [%].
-    pub max_fluctuation_pct: Option<f64>,
-    /// Smallest force estimate while the arm moved [N].
-    pub min_moving_force_n: Option<f64>,
-    /// RMS error of the estimate against the true force while holding [N].
-    pub force_rmse_n: Option<f64>,
-    /// Whether the grasp oscillated on its own (see `run::metrics`).
-    pub oscillating: bool,
+    /// Rise time, overshoot, fluctuation, estimate error, oscillation.
+    #[serde(flatten)]
+    pub metrics: ControlMetrics,
     /// Simulated (or cell) time covered [s].
     pub sim_time_s: f64,
     /// Wall-clock time of the run [s].
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub real_time_factor: f64,
-    /// Seed of every random process in the run.
-    pub seed: u64,
-    /// Which cell ran it ("mujoco", "real", ...).
-    pub backend: String,
     /// The error that ended the run, with its time.
     pub error: Option<String>,
-}
-
-/// What identifies a run besides its report.
-#[derive(Debug, Clone)]
-pub struct RunIdentity {
-    /// Scenario name.
-    pub scenario: String,
-    /// Object name.
-    pub object: String,
-    /// Object mass [kg].
-    pub mass_kg: f64,
-    /// Feedback while moving.
-    pub feedback: bool,
-    /// Gains.
-    pub gains: Gains,
-    /// Setpoint [N].
-    pub setpoint_n: f64,
-    /// Seed.
-    pub seed: u64,
-    /// Backend name.
-    pub backend: String,
 }
 
 impl RunSummary {
     /// A summary for a run that could not start (its scenario failed to build): outcome
     /// "error" with the cause, so a sweep records it and goes on.
     pub fn failed_to_start(scenario: &str, cause: String) -> RunSummary {
-        RunSummary { scenario: scenario.into(), outcome: "error".into(), error: Some(cause), ..Default::default() }
+        RunSummary {
+            run: RunIdentity { scenario: scenario.into(), ..Default::default() },
+            outcome: "error".into(),
+            error: Some(cause),
+            ..Default::default()
+        }
     }
 
     /// The column names of a flattened summary, in order (nested fields dotted: `gains.kp`).
@@ -103,12 +88,7 @@ impl RunSummary {
     pub fn new(id: RunIdentity, report: &RunReport, wall_time_s: f64) -> RunSummary {
         let since_motion = |t: f64| report.motion_start_s.map(|m| t - m);
         RunSummary {
-            scenario: id.scenario,
-            object: id.object,
-            mass_kg: id.mass_kg,
-            feedback: id.feedback,
-            gains: id.gains,
-            setpoint_n: id.setpoint_n,
+            run: id,
             outcome: match report.outcome {
                 Outcome::Held => "held",
                 Outcome::Dropped => "dropped",
@@ -119,17 +99,10 @@ impl RunSummary {
             drop_cell_time_s: report.drop.map(|d| d.cell_time_s),
             drop_phase: report.drop.map(|d| d.phase.name().to_string()),
             slip_detected_s: report.slip.slip_start_s.and_then(since_motion),
-            rise_time_90_s: report.metrics.rise_time_90_s,
-            overshoot_pct: report.metrics.overshoot_pct,
-            max_fluctuation_pct: report.metrics.max_fluctuation_pct,
-            min_moving_force_n: report.metrics.min_moving_force_n,
-            force_rmse_n: report.metrics.force_rmse_n,
-            oscillating: report.metrics.oscillating,
+            metrics: report.metrics,
             sim_time_s: report.cell_time_s,
             wall_time_s,
             real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },
-            seed: id.seed,
-            backend: id.backend,
             error: report.error.clone(),
         }
     }
@@ -140,16 +113,16 @@ pub fn render_text(s: &RunSummary) -> String {
     let opt = |v: Option<f64>, unit: &str| v.map_or("-".to_string(), |v| format!("{v:.2} {unit}"));
     let mut out = format!(
         "{} ({}, {:.0} g, setpoint {} N, feedback {}, Kp {} Ki {} Kd {}, seed {}, {})\n",
-        s.scenario,
-        s.object,
-        s.mass_kg * 1e3,
-        s.setpoint_n,
-        if s.feedback { "on" } else { "off" },
-        s.gains.kp,
-        s.gains.ki,
-        s.gains.kd,
-        s.seed,
-        s.backend
+        s.run.scenario,
+        s.run.object,
+        s.run.mass_kg * 1e3,
+        s.run.setpoint_n,
+        if s.run.feedback { "on" } else { "off" },
+        s.run.gains.kp,
+        s.run.gains.ki,
+        s.run.gains.kd,
+        s.run.seed,
+        s.run.backend
     );
     out += &format!("  outcome            {}", s.outcome);
     if let (Some(t), Some(p)) = (s.drop_time_s, &s.drop_phase) {
@@ -159,10 +132,10 @@ pub fn render_text(s: &RunSummary) -> String {
     if let Some(e) = &s.error {
         out += &format!("  error              {e}\n");
     }
-    out += &format!("  rise time (90 %)   {}\n", opt(s.rise_time_90_s, "s"));
-    out += &format!("  overshoot          {:.1} %\n", s.overshoot_pct);
-    out += &format!("  max fluctuation    {}\n", opt(s.max_fluctuation_pct, "%"));
-    out += &format!("  estimate RMSE      {}\n", opt(s.force_rmse_n, "N"));
+    out += &format!("  rise time (90 %)   {}\n", opt(s.metrics.rise_time_90_s, "s"));
+    out += &format!("  overshoot          {:.1} %\n", s.metrics.overshoot_pct);
+    out += &format!("  max fluctuation    {}\n", opt(s.metrics.max_fluctuation_pct, "%"));
+    out += &format!("  estimate RMSE      {}\n", opt(s.metrics.force_rmse_n, "N"));
     out += &format!(
         "  simulated {:.1} s in {:.2} s wall: {:.0}x real time\n",
         s.sim_time_s, s.wall_time_s, s.real_time_factor

@@ -22,11 +22,11 @@ pub fn run(scenarios: &[PathBuf], kp: &[f64], ki: &[f64], out: &Path, threads: u
         }
         for r in run_all(scenario, sets, threads)? {
             rows.push(GainMapRow {
-                object: r.summary.object.clone(),
-                kp: r.summary.gains.kp,
-                ki: r.summary.gains.ki,
+                object: r.summary.run.object.clone(),
+                kp: r.summary.run.gains.kp,
+                ki: r.summary.run.gains.ki,
                 outcome: r.summary.outcome.clone(),
-                oscillating: r.summary.oscillating,
+                oscillating: r.summary.metrics.oscillating,
             });
         }
     }

@@ -99,7 +99,7 @@ pub fn run(scenario: &Path, grid: &Grid, defaults: (f64, &str, &str, u32), out: 
                 _ => None,
             };
             SpeedAccuracyRow {
-                backend: r.summary.backend.clone(),
+                backend: r.summary.run.backend.clone(),
                 integrator: integrator.into(),
                 cone: cone.into(),
                 timestep_s: dt,

@@ -36,7 +36,7 @@ pub fn run(scenario: &Path, timesteps: &[f64], out: &Path, threads: usize) -> an
                 _ => "stable",
             };
             StabilityRow {
-                backend: r.summary.backend.clone(),
+                backend: r.summary.run.backend.clone(),
                 integrator: integrator.into(),
                 timestep_s: dt,
                 outcome: outcome.into(),
