@@ -185,9 +185,10 @@ pub struct FingerConfig {
     pub relaxed_fraction: f64,
     /// Relaxation time tau [s] of the standard linear solid (dashpot c = tau (1 - f) K).
     /// Tuned so that, as in the paper, the three objects drop ≈ 10, 13 and 17 s after the arm
-    /// starts: with 45 s the frozen grip keeps 80 / 75 / 69 % of its value at 10 / 13 / 17 s, a
-    /// spread that the objects' friction margins (1.25 / 1.33 / 1.46 × weight at the setpoint) turn
-    /// into those drop times. Tens of seconds is the usual range of TPU stress relaxation.
+    /// starts: with 30 s the frozen grip falls to ≈ 75 % of its value 10 s after the lift starts and
+    /// ≈ 65 % after 20 s (the strip's bending stiffness does not relax), and the objects' friction
+    /// margins turn that decay into the drop times (models/README.md has the figures). Tens of
+    /// seconds is the usual range of TPU stress relaxation.
     pub relaxation_time_s: f64,
     /// Equivalent translating inertia of each MX-106 at its output [kg] (joint armature). A choice.
     pub motor_armature_kg: f64,
@@ -239,7 +240,7 @@ impl Default for FingerConfig {
             moment_arm_m: 0.003,
             tendon_stiffness_n_m: 2000.0,
             relaxed_fraction: 0.05,
-            relaxation_time_s: 45.0,
+            relaxation_time_s: 30.0,
             motor_armature_kg: 2.0,
             motor_kp_n_m: 20000.0,
             motor_kv_n_s_m: 400.0,
@@ -335,7 +336,8 @@ impl ObjectName {
 pub struct ObjectConfig {
     /// The object (`crimper` | `hammer` | `shampoo`).
     pub name: ObjectName,
-    /// Sliding friction of the object against the finger, replacing the model's material value.
+    /// Sliding friction of the object against the finger, replacing the model's value on the grip
+    /// (`object_grip`, the only part the finger and palm touch; the base keeps its table friction).
     pub friction: Option<f64>,
     /// Where the object's footprint centre stands on the table, world x and y [m]. `None`: right under
     /// the gripper's wrap in the start pose (the scene starts at the grasp).

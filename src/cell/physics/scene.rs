@@ -66,12 +66,11 @@ impl SceneModel {
             MjModel::from_xml_string(&xml).map_err(|e| PhysicsError::Compile { message: format!("{e:?}") })?;
         let ids = Self::find_ids(&model, spec)?;
 
-        // Object: material friction override on every object geom, start pose on the table.
+        // Object: friction override on the grip the finger touches (its base keeps its own friction
+        // against the table), start pose on the table.
         if let Some(obj) = &spec.object {
-            if let Some(mu) = obj.friction {
-                for &g in &ids.object_geoms {
-                    model.geom_friction_mut()[g][0] = mu;
-                }
+            if let (Some(mu), Some(g)) = (obj.friction, ids.object_grip) {
+                model.geom_friction_mut()[g][0] = mu;
             }
             if let (Some(adr), Some(p)) = (ids.object_qpos, placement.object) {
                 model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, 1.0, 0.0, 0.0, 0.0]);
