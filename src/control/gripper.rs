@@ -16,20 +16,21 @@ pub struct GripperConfig {
     /// that fits the MX-106 horn; 14 cm of growth is then 1.9 motor turns.
     pub growth_pinion_radius_m: f64,
     /// Radius of the twine tendon spool [m]. With the finger's stiffness this sets the force gain
-    /// dF/dθ that the paper's PID gains act on (see `control::pid`). Tuned: 8 mm, so that, as in the
-    /// paper, Kp = 20 (°/s)/N brings the pad to 90 % of the setpoint in 3-5 s: on the twin the pad
-    /// force grows by ≈ 0.012-0.02 N per degree of motor near the setpoints (0.14 mm of tendon per
-    /// degree), a loop time constant 1/(Kp·dF/dθ) ≈ 2.5-4 s. (5 mm gave 8-12 s.) A drum of 16 mm
-    /// diameter on the MX-106 horn is an ordinary size.
+    /// dF/dθ that the paper's PID gains act on (see `control::pid`). Tuned: 16 mm, so that, as in the
+    /// paper, Kp = 20 (°/s)/N brings the pad to 90 % of the setpoint within 5 s (twin: 1-4.6 s over
+    /// seeds 1-5): 0.28 mm of tendon per motor degree; near the setpoints the pad force grows by
+    /// ≈ 0.02-0.05 N per degree, a loop time constant 1/(Kp·dF/dθ) ≈ 1-2.5 s. (5 mm gave 8-12 s.)
+    /// A 32 mm drum on the MX-106 horn is an ordinary size; the motor then winds ≤ 25 mm/s at the
+    /// PID's 90 °/s limit.
     pub twine_spool_radius_m: f64,
-    /// Twine motor travel limit [°] from the straight finger: 423° winds 59 mm on the 8 mm spool,
+    /// Twine motor travel limit [°] from the straight finger: 211° winds 59 mm on the 16 mm spool,
     /// just inside the finger's tendon travel (`finger.twine_max_m`, 60 mm).
     pub twine_max_deg: f64,
 }
 
 impl Default for GripperConfig {
     fn default() -> Self {
-        GripperConfig { growth_pinion_radius_m: 0.012, twine_spool_radius_m: 0.008, twine_max_deg: 423.0 }
+        GripperConfig { growth_pinion_radius_m: 0.012, twine_spool_radius_m: 0.016, twine_max_deg: 211.0 }
     }
 }
 

@@ -85,8 +85,8 @@ pub struct TaskConfig {
     /// Growth feed speed [m/s]. 5 cm/s is a quarter of what the MX-106 (45 rpm) gives on a
     /// 12 mm pinion, a gentle feed for a soft strip.
     pub growth_speed_m_s: f64,
-    /// Twine speed of the guarded close before force control [°/s]. Tuned: 20 °/s (2.8 mm/s of
-    /// tendon on the 8 mm spool, below the 7.5 mm/s the physics tests wind at) so the close stops
+    /// Twine speed of the guarded close before force control [°/s]. Tuned: 15 °/s (4.2 mm/s of
+    /// tendon on the 16 mm spool, below the 7.5 mm/s the physics tests wind at) so the close stops
     /// near first contact, well below the setpoint, and the PID does the rise, as in the paper
     /// (at the PID's own limit, 90 °/s, the close overshot every setpoint before the PID started).
     pub wrap_speed_deg_s: f64,
@@ -123,7 +123,7 @@ impl Default for TaskConfig {
             settle_s: 0.5,
             growth_m: 0.14,
             growth_speed_m_s: 0.05,
-            wrap_speed_deg_s: 20.0,
+            wrap_speed_deg_s: 15.0,
             wrap_contact_n: 0.1,
             wrap_timeout_s: 20.0,
             grasp_s: 15.0,
