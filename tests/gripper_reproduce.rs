@@ -26,6 +26,30 @@ fn reproduce_gripper_passes_every_row() {
     assert!(out.status.success(), "exit {:?}\n{stdout}\n{}", out.status, String::from_utf8_lossy(&out.stderr));
 }
 
+/// Rows the calibration does not reach yet (models/README.md explains why); every other row must pass.
+const KNOWN_FAILING: [&str; 2] =
+    ["hammer, no feedback: outcome", "hammer, no feedback: drop time after the arm starts [s]"];
+
+#[test]
+fn reproduce_gripper_passes_all_but_the_known_hammer_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("rows.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_tendril"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["reproduce", "gripper", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let failed: Vec<&serde_json::Value> = rows
+        .iter()
+        .filter(|r| r["pass"] != serde_json::Value::Bool(true))
+        .filter(|r| !KNOWN_FAILING.contains(&r["quantity"].as_str().unwrap()))
+        .collect();
+    assert!(failed.is_empty(), "failing rows: {failed:#?}\n{stdout}");
+}
+
 #[test]
 fn reproduce_gripper_writes_fifteen_rows() {
     let dir = tempfile::tempdir().unwrap();
