@@ -18,8 +18,10 @@ pub struct GripperConfig {
     /// Radius of the twine tendon spool [m]. With the finger's stiffness this sets the force gain
     /// dF/dθ that the paper's PID gains act on (see `control::pid`). Tuned: 16 mm, so that, as in the
     /// paper, Kp = 20 (°/s)/N brings the pad to 90 % of the setpoint within 5 s (twin: 1-4.6 s over
-    /// seeds 1-5): 0.28 mm of tendon per motor degree; near the setpoints the pad force grows by
-    /// ≈ 0.02-0.05 N per degree, a loop time constant 1/(Kp·dF/dθ) ≈ 1-2.5 s. (5 mm gave 8-12 s.)
+    /// seeds 1-5): 0.28 mm of tendon per motor degree; at the start of the grasp the pad force grows
+    /// by ≈ 0.06-0.11 N per degree (crimper / shampoo / hammer, measured on the twin), a loop time
+    /// constant 1/(Kp·dF/dθ) ≈ 0.5-0.8 s; the finger's creep then slows the last part of the rise.
+    /// (5 mm gave 8-12 s.)
     /// A 32 mm drum on the MX-106 horn is an ordinary size; the motor then winds ≤ 25 mm/s at the
     /// PID's 90 °/s limit.
     pub twine_spool_radius_m: f64,
