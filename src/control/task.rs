@@ -72,7 +72,11 @@ pub struct TaskConfig {
     pub lift_deg: [f64; ARM_JOINTS],
     /// Pose above the collection site [°]: base turned 60° from the lift pose.
     pub transfer_deg: [f64; ARM_JOINTS],
-    /// Pose at the collection site [°]: the lift reversed at the new base angle.
+    /// Pose at the collection site [°]: the lift reversed at the new base angle, stopping ≈ 1.5 cm
+    /// (a tenth of the lift) above the table, from where the release lets the object down: an object
+    /// that slipped a few millimetres in the hand would otherwise be pushed into the table at the
+    /// end of the lowering, loading the pad by up to 3× the setpoint while the arm still moves
+    /// (tuned so that the fluctuation while moving is the grip's, as in the paper's Fig. 9).
     pub place_deg: [f64; ARM_JOINTS],
     /// Time at home before growing, while the sensor is tared [s].
     pub settle_s: f64,
@@ -81,7 +85,10 @@ pub struct TaskConfig {
     /// Growth feed speed [m/s]. 5 cm/s is a quarter of what the MX-106 (45 rpm) gives on a
     /// 12 mm pinion, a gentle feed for a soft strip.
     pub growth_speed_m_s: f64,
-    /// Twine speed of the guarded close before force control [°/s]: the PID's own speed limit.
+    /// Twine speed of the guarded close before force control [°/s]. Tuned: 15 °/s (4.2 mm/s of
+    /// tendon on the 16 mm spool, below the 7.5 mm/s the physics tests wind at) so the close stops
+    /// near first contact, well below the setpoint, and the PID does the rise, as in the paper
+    /// (at the PID's own limit, 90 °/s, the close overshot every setpoint before the PID started).
     pub wrap_speed_deg_s: f64,
     /// Rise of the force estimate above its unloaded reading that ends the guarded close [N]:
     /// first contact. 0.1 N is 40× the noise-limited resolution (paper: 2.57 mN), well clear of
@@ -112,11 +119,11 @@ impl Default for TaskConfig {
             home_deg: [-90.0, -90.0, 90.0, -90.0, -90.0, 0.0],
             lift_deg: [-90.0, -100.0, 80.0, -70.0, -90.0, 0.0],
             transfer_deg: [-30.0, -100.0, 80.0, -70.0, -90.0, 0.0],
-            place_deg: [-30.0, -90.0, 90.0, -90.0, -90.0, 0.0],
+            place_deg: [-30.0, -91.0, 89.0, -88.0, -90.0, 0.0],
             settle_s: 0.5,
             growth_m: 0.14,
             growth_speed_m_s: 0.05,
-            wrap_speed_deg_s: 90.0,
+            wrap_speed_deg_s: 15.0,
             wrap_contact_n: 0.1,
             wrap_timeout_s: 20.0,
             grasp_s: 15.0,
