@@ -62,6 +62,8 @@ pub struct GroundTruth {
     pub slip_speed_m_s: f64,
     /// Whether the finger (or pad) touches the object at all.
     pub in_contact: bool,
+    /// Where the object's grip point sits in the hand's frame [m]; its change is slip.
+    pub object_in_hand_m: [f64; 3],
 }
 
 /// Why a cell operation failed.

@@ -4,7 +4,7 @@
 use std::process::Command;
 
 #[test]
-#[ignore = "13 of 15 rows pass: the hammer without feedback drops in the transfer at ~13 s, not in the lowering at ~17 s (models/README.md, calibration)"]
+#[ignore = "13 of 15 rows pass: the hammer without feedback drops early in the transfer (~11 s), not in the lowering at ~17 s (models/README.md, calibration)"]
 fn reproduce_gripper_passes_every_row() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("rows.json");

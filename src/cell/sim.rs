@@ -187,6 +187,7 @@ impl Cell for SimCell {
             object_height_m: r.object_pos_m[2] - self.model.placement().table_z,
             slip_speed_m_s: r.slip_speed_m_s,
             in_contact: r.touching,
+            object_in_hand_m: r.object_in_hand_m,
         })
     }
 }

@@ -45,8 +45,13 @@ pub struct JointMove {
 }
 
 impl JointMove {
-    /// Plans the fastest move within `limits` that lasts at least `min_duration_s`.
-    /// Angles in radians.
+    /// Plans a move within `limits` that lasts at least `min_duration_s`.
+    ///
+    /// Without a minimum duration the move is time-optimal. A move stretched beyond that is
+    /// slowed as a whole, acceleration included, the way a motion planner's velocity and
+    /// acceleration scaling does: it accelerates over its first third, cruises, and brakes over
+    /// its last third. (Full acceleration to a slow cruise would jolt the hand at the start and
+    /// load a freshly lifted object in a fraction of a second.) Angles in radians.
     pub fn plan(
         from: [f64; ARM_JOINTS],
         to: [f64; ARM_JOINTS],
@@ -62,7 +67,12 @@ impl JointMove {
         // Fastest profile: triangular when the speed limit is never reached, trapezoidal otherwise.
         let fastest = if v * v / a >= 1.0 { 2.0 / a.sqrt() } else { 1.0 / v + v / a };
         let duration_s = fastest.max(min_duration_s);
-        // Cruise rate w for this duration at full acceleration: 1 = w (T − w / a).
+        // Thirds profile: ramps of T/3 reach the rate 1.5/T with acceleration 4.5/T².
+        let (third_rate, third_accel) = (1.5 / duration_s, 4.5 / duration_s.powi(2));
+        if third_rate <= v && third_accel <= a {
+            return JointMove { from, to, duration_s, ramp_s: duration_s / 3.0, peak_rate: third_rate };
+        }
+        // Close to the fastest move: full acceleration, cruise rate w from 1 = w (T − w / a).
         let disc = (a * duration_s).powi(2) - 4.0 * a;
         let peak_rate = (a * duration_s - disc.max(0.0).sqrt()) / 2.0;
         JointMove { from, to, duration_s, ramp_s: peak_rate / a, peak_rate }
@@ -151,7 +161,8 @@ mod tests {
         let slow = JointMove::plan([0.0; 6], to, &JointLimits::default(), 10.0);
         assert_eq!(slow.duration_s(), 10.0);
         let (v, a) = peak_speed_and_accel(&slow);
-        assert!(v < 45.0 && a <= 15.1, "v {v} a {a}");
+        // Stretched moves scale acceleration too: ramps of a third, 20° × 4.5 / 10² = 0.9 °/s².
+        assert!((v - 3.0).abs() < 0.01 && (a - 0.9).abs() < 0.05, "v {v} a {a}");
         // Joints stay synchronised: the second joint is always at minus half the first.
         let (q, _) = slow.sample(3.3);
         assert!((q[2] + 0.5 * q[1]).abs() < 1e-12);

@@ -1,5 +1,6 @@
 //! Running the pick-and-place task on a cell and recording it.
 //!
+//! - [`drop_watch`]: when a simulated object counts as dropped.
 //! - [`execute`]: one scenario on the twin, files written.
 //! - [`runner`]: the control loop over any [`crate::hardware::Cell`].
 //! - [`scenario`]: the pick-and-place scenario file.
@@ -7,6 +8,7 @@
 //! - [`metrics`]: rise time, overshoot, fluctuation, estimate error.
 //! - [`summary`]: the `summary.json` record.
 
+pub mod drop_watch;
 pub mod execute;
 pub mod metrics;
 pub mod runner;

@@ -2,6 +2,7 @@
 //!
 //! This is the code that runs unchanged on the twin and on the real cell.
 
+use super::drop_watch::DropWatch;
 use super::metrics::{ControlMetrics, control_metrics};
 use super::trace::{TraceRow, TraceWriter};
 use crate::control::estimate::{ForceCalibration, ForceEstimator};
@@ -76,10 +77,6 @@ pub struct RunReport {
     pub rows: Vec<TraceRow>,
 }
 
-/// Ground truth must say "no contact" this long before the object counts as lost [s]:
-/// a contact flickering during a slip is not yet a drop.
-const LOST_CONTACT_S: f64 = 0.3;
-
 /// Runs the task on `cell`, writing each tick to `trace` when given. The cell is configured,
 /// activated and, whatever happens, deactivated. Cell errors end the run with
 /// [`Outcome::Error`]; the rows up to the error are kept.
@@ -88,8 +85,8 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
     let mut sequencer =
         TaskSequencer::new(plan.task.clone(), plan.gripper, Pid::new(plan.pid), plan.setpoint_n, plan.feedback);
     let mut slip = SlipDetector::new(plan.slip);
+    let mut drop_watch = DropWatch::default();
     let mut truth_drop: Option<Drop> = None;
-    let mut no_contact_since: Option<f64> = None;
     let dt = 1.0 / plan.rate_hz;
 
     let mut run = || -> Result<(), CellError> {
@@ -117,15 +114,8 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
             cell.write(&decision.command)?;
 
             let truth = cell.ground_truth();
-            if let Some(t) = truth {
-                if decision.phase.arm_moving() && !t.in_contact && truth_drop.is_none() {
-                    let since = *no_contact_since.get_or_insert(state.time_s);
-                    if state.time_s - since >= LOST_CONTACT_S {
-                        truth_drop = Some(Drop { cell_time_s: since, phase: phase_at(&rows, since) });
-                    }
-                } else {
-                    no_contact_since = None;
-                }
+            if let Some(t) = &truth {
+                truth_drop = drop_watch.update(state.time_s, decision.phase, t);
             }
             let nan = f64::NAN;
             let row = TraceRow {
