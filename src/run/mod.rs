@@ -9,6 +9,7 @@
 
 pub mod execute;
 pub mod metrics;
+pub mod real;
 pub mod runner;
 pub mod scenario;
 pub mod summary;

@@ -8,6 +8,7 @@
 pub mod cell;
 pub mod dxl;
 pub mod interrogator;
+pub mod latency;
 pub mod limits;
 pub mod protocol;
 pub mod serve;
