@@ -14,7 +14,9 @@ fn python() -> Option<String> {
     match std::env::var("TENDRIL_PYTHON") {
         Ok(p) if !p.is_empty() => Some(p),
         _ => {
-            eprintln!("SKIPPED: TENDRIL_PYTHON is not set; run `cargo xtask test` to install ur_rtde and dynamixel-sdk");
+            eprintln!(
+                "SKIPPED: TENDRIL_PYTHON is not set; run `cargo xtask test` to install ur_rtde and dynamixel-sdk"
+            );
             None
         }
     }
