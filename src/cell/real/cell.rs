@@ -11,6 +11,7 @@
 //! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way;
 //! - `deactivate` (every exit path): enable flag 0 → the URScript program `stopj`s the arm;
 //!   gripper goal = present position with torque ON (holds the object); see [`super::dxl`].
+//!
 //! Joint speed/acceleration limits and the force ceiling are the [`super::limits::LimitedCell`]
 //! decorator's job.
 
