@@ -155,3 +155,108 @@ impl<C: Cell> Cell for LimitedCell<C> {
         self.inner.ground_truth()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::signals::Wavelengths;
+
+    /// A cell that records commands; time advances 10 ms per read; wavelengths are settable.
+    struct Recorder {
+        t: f64,
+        w: Wavelengths,
+        twine: f64,
+        written: Vec<CellCommand>,
+    }
+
+    impl Cell for Recorder {
+        fn backend(&self) -> &str {
+            "recorder"
+        }
+        fn lifecycle(&self) -> Lifecycle {
+            Lifecycle::Active
+        }
+        fn configure(&mut self) -> Result<(), CellError> {
+            Ok(())
+        }
+        fn activate(&mut self) -> Result<(), CellError> {
+            Ok(())
+        }
+        fn deactivate(&mut self) -> Result<(), CellError> {
+            Ok(())
+        }
+        fn read(&mut self) -> Result<CellState, CellError> {
+            self.t += 0.01;
+            let q = self.written.last().map_or([0.0; ARM_JOINTS], |c| c.arm_q);
+            Ok(CellState {
+                time_s: self.t,
+                arm_q: q,
+                growth_motor_rad: 0.0,
+                twine_motor_rad: self.twine,
+                wavelengths: self.w,
+            })
+        }
+        fn write(&mut self, c: &CellCommand) -> Result<(), CellError> {
+            self.written.push(*c);
+            Ok(())
+        }
+        fn wait_until(&mut self, _: f64) -> Result<(), CellError> {
+            Ok(())
+        }
+    }
+
+    fn limited() -> LimitedCell<Recorder> {
+        let w = Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 };
+        let limits = SafetyLimits {
+            max_speed_rad_s: 1.0,
+            max_accel_rad_s2: 10.0,
+            max_force_n: 2.0,
+            calibration: ForceCalibration::default(),
+        };
+        LimitedCell::new(Recorder { t: 0.0, w, twine: 1.0, written: Vec::new() }, limits)
+    }
+
+    fn command(q0: f64, twine: f64) -> CellCommand {
+        let mut arm_q = [0.0; ARM_JOINTS];
+        arm_q[0] = q0;
+        CellCommand { arm_q, growth_motor_rad: 0.0, twine_motor_rad: twine }
+    }
+
+    #[test]
+    fn a_jump_in_the_arm_target_is_ramped_within_speed_and_acceleration() {
+        let mut c = limited();
+        c.activate().unwrap();
+        for _ in 0..200 {
+            c.read().unwrap();
+            c.write(&command(1.0, 1.0)).unwrap();
+        }
+        let q: Vec<f64> = c.inner().written.iter().map(|w| w.arm_q[0]).collect();
+        let dt = 0.01;
+        for pair in q.windows(2) {
+            assert!((pair[1] - pair[0]).abs() <= 1.0 * dt + 1e-12, "speed limit broken: {pair:?}");
+        }
+        for triple in q.windows(3) {
+            let change = (triple[2] - triple[1]) - (triple[1] - triple[0]);
+            assert!(change.abs() <= 10.0 * dt * dt + 1e-12, "acceleration limit broken: {triple:?}");
+        }
+        assert!((q.last().unwrap() - 1.0).abs() < 1e-9, "the target is reached in the end: {}", q.last().unwrap());
+        assert!(c.interventions.0 > 0);
+    }
+
+    #[test]
+    fn above_the_force_ceiling_the_twine_may_loosen_but_not_tighten() {
+        let mut c = limited();
+        c.activate().unwrap();
+        c.read().unwrap(); // tare at 1540 / 1550 nm
+        c.write(&command(0.0, 1.5)).unwrap();
+        assert_eq!(c.inner().written.last().unwrap().twine_motor_rad, 1.5, "below the ceiling: unchanged");
+        // About 3 N on eq. (8): 144.99·9 + 527.62·3 − 91.42 ≈ 2796 pm on FBG1 alone.
+        c.inner.w.fbg1_nm += 2.796;
+        c.read().unwrap();
+        c.write(&command(0.0, 1.5)).unwrap();
+        assert_eq!(c.inner().written.last().unwrap().twine_motor_rad, 1.0, "held at the measured twine");
+        c.write(&command(0.0, 0.5)).unwrap();
+        assert_eq!(c.inner().written.last().unwrap().twine_motor_rad, 0.5, "loosening is allowed");
+        assert_eq!(c.interventions.1, 1);
+    }
+}
