@@ -16,6 +16,8 @@ pub struct LatencyReport {
     pub max_s: f64,
     /// Ticks whose read → write finished after the next tick's deadline.
     pub missed_deadlines: usize,
+    /// 99th percentile of the read → write time alone, without the wake-up lateness [s].
+    pub work_p99_s: f64,
 }
 
 /// Runs `cell` (configured and activated here) at `rate_hz` for `seconds`, holding the measured
@@ -28,10 +30,12 @@ pub fn measure(cell: &mut dyn Cell, rate_hz: f64, seconds: f64) -> Result<Latenc
     cell.activate()?;
     let n = (seconds * rate_hz).round().max(1.0) as usize;
     let mut latencies = Vec::with_capacity(n);
+    let mut work = Vec::with_capacity(n);
     let mut missed = 0;
     let result = (|| {
         for k in 0..n {
             let deadline = start + Duration::from_secs_f64(k as f64 * period);
+            let woke = Instant::now();
             let s = cell.read()?;
             cell.write(&CellCommand {
                 arm_q: s.arm_q,
@@ -43,6 +47,7 @@ pub fn measure(cell: &mut dyn Cell, rate_hz: f64, seconds: f64) -> Result<Latenc
                 missed += 1;
             }
             latencies.push(latency);
+            work.push(woke.elapsed().as_secs_f64());
             cell.wait_until((k + 1) as f64 * period)?;
         }
         Ok::<(), CellError>(())
@@ -51,12 +56,15 @@ pub fn measure(cell: &mut dyn Cell, rate_hz: f64, seconds: f64) -> Result<Latenc
     result?;
     stop?;
     latencies.sort_by(f64::total_cmp);
-    let pct = |p: f64| latencies[((latencies.len() - 1) as f64 * p).round() as usize];
+    work.sort_by(f64::total_cmp);
+    let at = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    let pct = |p: f64| at(&latencies, p);
     Ok(LatencyReport {
         ticks: latencies.len(),
         p50_s: pct(0.5),
         p99_s: pct(0.99),
         max_s: latencies.last().copied().unwrap_or(0.0),
         missed_deadlines: missed,
+        work_p99_s: at(&work, 0.99),
     })
 }
