@@ -27,13 +27,19 @@ pub struct LatencyArgs {
     /// loaded machine shows up in the figures instead of ending the measurement.
     #[arg(long, default_value_t = 50.0)]
     sensor_stale_samples: f64,
+    /// Run the control thread and the twin/bus threads under SCHED_FIFO at this priority (1-99;
+    /// needs root or CAP_SYS_NICE); 0 leaves normal scheduling.
+    #[arg(long, default_value_t = 0)]
+    rt_priority: i32,
 }
 
 pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(a.seconds > 0.0 && a.seconds <= 3600.0, "--seconds must be in (0, 3600]");
     anyhow::ensure!(a.rate_hz > 0.0 && a.rate_hz <= 2000.0, "--rate-hz must be in (0, 2000]");
     let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &[])?;
-    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(a.port_base))?;
+    let mut serve_config = ServeConfig::loopback().with_port_base(a.port_base);
+    serve_config.rt_priority = a.rt_priority;
+    let serve = start(&scenario, &serve_config)?;
     let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
     config.rtde_port = serve.addrs[0].port();
     config.script_port = serve.addrs[1].port();
@@ -41,6 +47,10 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     config.stream_port = serve.addrs[3].port();
     config.sensor_stale_samples = a.sensor_stale_samples;
     config.arm_stale_s = a.sensor_stale_samples * 2e-3;
+    if a.rt_priority > 0 {
+        crate::cell::real::latency::set_realtime_priority(a.rt_priority)
+            .map_err(|e| anyhow::anyhow!("--rt-priority {}: {e}", a.rt_priority))?;
+    }
     let mut cell = RealCell::new(config);
     let r = measure(&mut cell, a.rate_hz, a.seconds)?;
     drop(cell);

@@ -68,3 +68,12 @@ pub fn measure(cell: &mut dyn Cell, rate_hz: f64, seconds: f64) -> Result<Latenc
         work_p99_s: at(&work, 0.99),
     })
 }
+
+/// Puts the calling thread under `SCHED_FIFO` at `priority` (1-99), as real-time robot drivers do
+/// (ur_rtde's `rt_priority`). Needs CAP_SYS_NICE or root; the error says why it failed.
+pub fn set_realtime_priority(priority: i32) -> std::io::Result<()> {
+    let param = libc::sched_param { sched_priority: priority };
+    // SAFETY: plain syscall on the calling thread with a valid parameter struct.
+    let rc = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) };
+    if rc == 0 { Ok(()) } else { Err(std::io::Error::last_os_error()) }
+}

@@ -39,6 +39,10 @@ pub struct ServeConfig {
     pub stream_port: u16,
     /// Twin tick [s]: the RTDE output and peak stream period. 1 ms = the si255's 1 kHz scan rate.
     pub period_s: f64,
+    /// SCHED_FIFO priority of the twin, bus and network threads (0: normal scheduling). The
+    /// virtual devices stand in for dedicated hardware; on a shared machine this keeps them from
+    /// waiting behind other processes. Needs root or CAP_SYS_NICE.
+    pub rt_priority: i32,
 }
 
 impl ServeConfig {
@@ -51,6 +55,7 @@ impl ServeConfig {
             command_port: 51971,
             stream_port: 51972,
             period_s: 1e-3,
+            rt_priority: 0,
         }
     }
 
@@ -117,9 +122,23 @@ pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Resu
     anyhow::ensure!(config.period_s > 0.0 && config.period_s <= 0.01, "twin period must be in (0, 10 ms]");
     let stop = Arc::new(AtomicBool::new(false));
     let (state, ticks) = twin::shared_state()?;
-    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build()?;
+    let rt = config.rt_priority;
+    if rt > 0 {
+        // Fail early and clearly rather than in each thread.
+        let probe = std::thread::spawn(move || crate::cell::real::latency::set_realtime_priority(rt));
+        probe.join().map_err(|_| anyhow::anyhow!("priority probe panicked"))??;
+    }
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .on_thread_start(move || {
+            if rt > 0 {
+                let _ = crate::cell::real::latency::set_realtime_priority(rt);
+            }
+        })
+        .build()?;
     let addrs = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe()))?;
-    let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone())?;
-    let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone())?;
+    let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone(), rt)?;
+    let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone(), rt)?;
     Ok(ServeHandle { pty_path, addrs, state, stop, twin: Some(twin), bus: Some(bus), runtime: Some(runtime) })
 }

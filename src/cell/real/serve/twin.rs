@@ -93,6 +93,7 @@ fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
 pub fn open_bus(
     state: Arc<Mutex<DeviceState>>,
     stop: Arc<AtomicBool>,
+    rt_priority: i32,
 ) -> anyhow::Result<(PathBuf, std::thread::JoinHandle<()>)> {
     use std::os::unix::io::AsRawFd;
     let (mut master, slave) = serial2::SerialPort::pair()?;
@@ -102,6 +103,9 @@ pub fn open_bus(
     let handle = std::thread::Builder::new().name("dxl-bus".into()).spawn(move || {
         // Keeping the slave open means reads on the master never fail with EIO between clients.
         let _slave = slave;
+        if rt_priority > 0 {
+            let _ = crate::cell::real::latency::set_realtime_priority(rt_priority);
+        }
         let mut decoder = StreamDecoder::new();
         let mut chunk = [0u8; 1024];
         while !stop.load(Ordering::SeqCst) {
@@ -128,9 +132,13 @@ pub fn spawn(
     state: Arc<Mutex<DeviceState>>,
     ticks: tokio::sync::watch::Sender<u64>,
     stop: Arc<AtomicBool>,
+    rt_priority: i32,
 ) -> anyhow::Result<std::thread::JoinHandle<Result<(), String>>> {
     let model = SceneModel::build(&scenario.scene_spec())?;
     let run = move || -> Result<(), String> {
+        if rt_priority > 0 {
+            let _ = crate::cell::real::latency::set_realtime_priority(rt_priority);
+        }
         // Built here: the simulation's data stays on this thread.
         let mut cell = SimCell::new(
             model,
