@@ -6,7 +6,8 @@
 //!
 //! Safety on our side (the controller's and the servos' own limits still apply):
 //! - watchdog: a sensor sample older than `sensor_stale_samples` interrogator periods, or an arm
-//!   sample older than `arm_stale_s`, or the arm leaving running/normal mode, fails `read`; the
+//!   sample older than `arm_stale_s`, the arm leaving running/normal mode, or the follow program
+//!   no longer playing (stopped on the pendant), fails `read`; the
 //!   runner then calls [`Cell::deactivate`];
 //! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way;
 //! - `deactivate` (every exit path): enable flag 0 → the URScript program `stopj`s the arm;
@@ -18,7 +19,7 @@
 use super::dxl::GripperBus;
 use super::interrogator::{self, PeakFeed};
 use super::protocol::hyperion::FbgWindows;
-use super::protocol::rtde::state::{ROBOT_MODE_RUNNING, SAFETY_MODE_NORMAL};
+use super::protocol::rtde::state::{ROBOT_MODE_RUNNING, RUNTIME_STATE_PLAYING, SAFETY_MODE_NORMAL};
 use super::ur::{self, UrClient};
 use super::urscript::FOLLOW_SCRIPT;
 use crate::hardware::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, Lifecycle, require_state};
@@ -181,14 +182,18 @@ impl RealCell {
             let d = self.devices.as_ref().expect("just set");
             let arm = d.ur.latest().map_err(CellError::Configure)?;
             let sensor = d.peaks.lock().unwrap_or_else(|p| p.into_inner()).latest.is_some();
+            // The follow program must be playing before the cell may move the arm.
             if let Some((s, _)) = arm
                 && sensor
+                && (s.runtime_state == RUNTIME_STATE_PLAYING || !c.upload_program)
             {
                 self.last_arm_q = Some(s.q);
                 return Ok(());
             }
             if Instant::now() > deadline {
-                return Err(CellError::Configure("no RTDE or peak data within 2 s of connecting".into()));
+                return Err(CellError::Configure(
+                    "within 2 s of connecting: no RTDE or peak data, or the follow program is not playing".into(),
+                ));
             }
             std::thread::sleep(Duration::from_millis(2));
         }
@@ -239,6 +244,7 @@ impl Cell for RealCell {
         let time_s = self.started.elapsed().as_secs_f64();
         let sensor_stale = Duration::from_secs_f64(self.config.sensor_period_s * self.config.sensor_stale_samples);
         let arm_stale = Duration::from_secs_f64(self.config.arm_stale_s);
+        let upload = self.config.upload_program;
         let (_, d) = self.parts();
         let (arm, age) = d.ur.latest().map_err(|e| device("UR5e", e))?.ok_or_else(|| device("UR5e", "no data"))?;
         if age > arm_stale {
@@ -246,6 +252,9 @@ impl Cell for RealCell {
         }
         if arm.robot_mode != ROBOT_MODE_RUNNING || arm.safety_mode != SAFETY_MODE_NORMAL {
             return Err(device("UR5e", format!("robot mode {} safety mode {}", arm.robot_mode, arm.safety_mode)));
+        }
+        if upload && arm.runtime_state != RUNTIME_STATE_PLAYING {
+            return Err(device("UR5e", format!("follow program not playing (runtime state {})", arm.runtime_state)));
         }
         let wavelengths = {
             let feed = d.peaks.lock().unwrap_or_else(|p| p.into_inner());

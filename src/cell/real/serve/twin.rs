@@ -4,6 +4,7 @@ use crate::cell::physics::SceneModel;
 use crate::cell::real::protocol::dynamixel::units::{rad_to_ticks, ticks_to_rad};
 use crate::cell::real::protocol::dynamixel::{StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
+use crate::cell::real::protocol::rtde::state::RUNTIME_STATE_PLAYING;
 use crate::cell::real::protocol::rtde::{RobotOutputs, SharedInputs};
 use crate::cell::real::urscript::{ENABLE_REGISTER, FOLLOWING_REGISTER, TARGET_REGISTER};
 use crate::cell::sim::SimCell;
@@ -202,7 +203,10 @@ pub fn spawn(
             {
                 let mut s = lock(&state);
                 let following = s.program_loaded && s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
+                // The uploaded program runs forever once loaded: PLAYING (2), else STOPPED (1).
+                let runtime_state = if s.program_loaded { RUNTIME_STATE_PLAYING } else { 1 };
                 let o = &mut s.outputs;
+                o.runtime_state = runtime_state;
                 o.timestamp_s = r.time_s;
                 o.actual_qd = std::array::from_fn(|j| (r.arm_q[j] - previous_q[j]) / period_s);
                 o.actual_q = r.arm_q;
