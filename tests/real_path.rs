@@ -142,3 +142,53 @@ fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
     // Deactivation still terminates (devices gone: it reports, never hangs or panics).
     let _ = cell.deactivate();
 }
+
+#[test]
+fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
+    use tendril::hardware::{Cell, CellCommand};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
+    let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
+    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39760)).unwrap();
+    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
+    config.rtde_port = serve.addrs[0].port();
+    config.script_port = serve.addrs[1].port();
+    config.command_port = serve.addrs[2].port();
+    config.stream_port = serve.addrs[3].port();
+    config.sensor_stale_samples = 100.0;
+    config.arm_stale_s = 0.1;
+    let mut cell = tendril::cell::real::RealCell::new(config);
+    cell.configure().unwrap();
+    cell.activate().unwrap();
+    // Wind the twine motor for half a second, then stop as Ctrl-C does.
+    for k in 1..=50 {
+        let s = cell.read().unwrap();
+        let c = CellCommand { arm_q: s.arm_q, growth_motor_rad: 0.0, twine_motor_rad: 0.04 * k as f64 };
+        cell.write(&c).unwrap();
+        cell.wait_until(k as f64 * 0.01).unwrap();
+    }
+    let following = serve.state.lock().unwrap().inputs.values.int_registers[24];
+    assert_eq!(following, 1, "the enable register is set while active");
+    cell.stop_flag().store(true, std::sync::atomic::Ordering::SeqCst);
+    let err = cell.read().unwrap_err().to_string();
+    assert!(err.contains("stop requested"), "{err}");
+    cell.deactivate().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let s = serve.state.lock().unwrap();
+    assert_eq!(s.inputs.values.int_registers[24], 0, "the follow program is told to stop the arm");
+    for id in [1, 2] {
+        let t = s.bus.table(id).unwrap();
+        assert!(t.torque_enabled(), "motor {id} must keep torque on to hold the object");
+    }
+    // The twine motor holds where it was (goal = present at the stop, within the ticks it moved
+    // between the read and the twin's next update).
+    let twine = s.bus.table(2).unwrap();
+    assert!(twine.goal_position() > 100, "the twine motor had wound: goal {}", twine.goal_position());
+    assert!(
+        (twine.goal_position() - twine.present_position()).abs() <= 30,
+        "goal {} present {}",
+        twine.goal_position(),
+        twine.present_position()
+    );
+    drop(s);
+    serve.stop().unwrap();
+}
