@@ -71,13 +71,17 @@ fn real_path_against_virtual_devices_matches_the_twin() {
     assert_eq!(summary.backend, "real");
     assert!(grasped, "the finger never touched the object");
     assert!(longest_no_contact_s < 0.3, "object lost: {longest_no_contact_s:.2} s without contact");
-    // The sensor-based slip detector sees the same events on both paths.
-    assert_eq!(real.slip.lost_s.is_some(), sim.slip.lost_s.is_some(), "sim {:?} real {:?}", sim.slip, real.slip);
+    // Not compared: the sensor-based slip detector's events. On this scenario it flags a "loss"
+    // early in the grasp on both paths, when the force is still near the unloaded reading, and
+    // whether that lasts its 0.2 s is decided by noise; the ground truth above is the outcome.
     let names: Vec<_> = real.rows.iter().map(|r| r.phase.name()).collect();
     for phase in ["grow", "wrap", "grasp", "lift"] {
         assert!(names.contains(&phase), "real run never reached {phase}");
         let (f_sim, d_sim) = phase_stats(&sim, phase);
         let (f_real, d_real) = phase_stats(&real, phase);
+        eprintln!(
+            "{phase}: mean force sim {f_sim:.3} N real {f_real:.3} N; duration sim {d_sim:.2} s real {d_real:.2} s"
+        );
         assert!((f_sim - f_real).abs() < 0.1, "{phase}: mean force sim {f_sim:.3} N, real {f_real:.3} N");
         assert!((d_sim - d_real).abs() < 0.2, "{phase}: duration sim {d_sim:.2} s, real {d_real:.2} s");
     }
