@@ -3,7 +3,7 @@
 //! lift scenario (about 13 s of wall time), compared with the same scenario on the simulated path.
 //!
 //! Tolerances: the real path's timing jitters (ticks land a fraction of a millisecond late, the
-//! twin steps on its own clock), so traces are not identical; phase means of the force estimate
+//! twin steps on its own clock), so traces are not identical; phase medians of the force estimate
 //! must agree within 0.1 N (a sixth of the 0.6 N setpoint, about 40 times the sensor's 2.6 mN
 //! resolution) and phase durations within 0.2 s.
 
@@ -17,9 +17,13 @@ use tendril::run::scenario::PickPlaceScenario;
 fn phase_stats(report: &RunReport, phase: &str) -> (f64, f64) {
     let rows: Vec<_> = report.rows.iter().filter(|r| r.phase.name() == phase).collect();
     assert!(!rows.is_empty(), "no {phase} rows");
-    let mean = rows.iter().map(|r| r.force_n).sum::<f64>() / rows.len() as f64;
+    // The median: the lift has force spikes of several newtons as the object shifts in the hand,
+    // whose timing the real path's jitter moves; the median is what the hand holds with.
+    let mut forces: Vec<f64> = rows.iter().map(|r| r.force_n).collect();
+    forces.sort_by(f64::total_cmp);
+    let median = forces[forces.len() / 2];
     let duration = rows.last().unwrap().time_s - rows[0].time_s;
-    (mean, duration)
+    (median, duration)
 }
 
 #[test]
@@ -80,9 +84,9 @@ fn real_path_against_virtual_devices_matches_the_twin() {
         let (f_sim, d_sim) = phase_stats(&sim, phase);
         let (f_real, d_real) = phase_stats(&real, phase);
         eprintln!(
-            "{phase}: mean force sim {f_sim:.3} N real {f_real:.3} N; duration sim {d_sim:.2} s real {d_real:.2} s"
+            "{phase}: median force sim {f_sim:.3} N real {f_real:.3} N; duration sim {d_sim:.2} s real {d_real:.2} s"
         );
-        assert!((f_sim - f_real).abs() < 0.1, "{phase}: mean force sim {f_sim:.3} N, real {f_real:.3} N");
+        assert!((f_sim - f_real).abs() < 0.1, "{phase}: median force sim {f_sim:.3} N, real {f_real:.3} N");
         assert!((d_sim - d_real).abs() < 0.2, "{phase}: duration sim {d_sim:.2} s, real {d_real:.2} s");
     }
 }
