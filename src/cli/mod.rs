@@ -1,11 +1,14 @@
 //! Command-line interface: one file per command group, each with its arguments and handler.
 
 mod chart;
+mod devices;
+mod latency;
 mod physics;
 mod plot;
 mod reproduce;
 mod run;
 mod sensor;
+mod serve;
 mod sweep;
 
 use clap::{Parser, Subcommand};
@@ -45,6 +48,11 @@ enum Command {
     Bench(sensor::BenchArgs),
     /// Build the physics scene from a scenario and run a scripted grasp, printing the readout.
     PhysicsCheck(physics::PhysicsCheckArgs),
+    /// Run the twin in real time behind the real devices' protocols (RTDE, URScript, a Dynamixel
+    /// bus on a pseudo-terminal, HYPERION); loopback unless --bind says otherwise.
+    Serve(serve::ServeArgs),
+    /// Measure the real path's control-tick latency against the virtual devices on loopback.
+    Latency(latency::LatencyArgs),
 }
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
@@ -60,6 +68,8 @@ pub fn main() -> ExitCode {
         Command::Calibrate(a) => sensor::calibrate(a),
         Command::Bench(a) => sensor::bench(a),
         Command::PhysicsCheck(a) => physics::run(a),
+        Command::Serve(a) => serve::run(a),
+        Command::Latency(a) => latency::run(a),
     };
     match result {
         Ok(code) => code,

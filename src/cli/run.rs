@@ -25,6 +25,11 @@ pub struct RunArgs {
     /// Override a scenario value: `--set key.path=value` (repeatable), checked like the file.
     #[arg(long = "set")]
     set: Vec<Override>,
+    /// Which cell runs the task: the twin (`sim`) or the devices (`real`).
+    #[arg(long, value_parser = ["sim", "real"], default_value = "sim")]
+    hardware: String,
+    #[command(flatten)]
+    devices: super::devices::DeviceArgs,
 }
 
 impl RunArgs {
@@ -44,7 +49,13 @@ impl RunArgs {
 pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.overrides())?;
     let dir = a.out.clone().unwrap_or_else(|| Path::new("out").join(&scenario.name));
-    let (summary, _) = run_on_twin(&scenario, &Default::default(), Some(&dir))?;
+    let (summary, _) = if a.hardware == "real" {
+        let mut config = a.devices.config(&scenario)?;
+        config.handle_ctrl_c = true;
+        crate::run::real::run_on_real(&scenario, config, Some(&dir))?
+    } else {
+        run_on_twin(&scenario, &Default::default(), Some(&dir))?
+    };
     emit(&render_text(&summary));
     emit(&format!("wrote {0}/trace.csv and {0}/summary.json\n", dir.display()));
     Ok(if summary.outcome == "error" { ExitCode::FAILURE } else { ExitCode::SUCCESS })

@@ -11,6 +11,7 @@
 pub mod drop_watch;
 pub mod execute;
 pub mod metrics;
+pub mod real;
 pub mod runner;
 pub mod scenario;
 pub mod summary;

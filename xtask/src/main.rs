@@ -5,7 +5,8 @@
 //!
 //! - `cargo xtask fetch`: unpack MuJoCo 3.17.0 from the PyPI wheel into `vendor/mujoco/lib`.
 //! - `cargo xtask main`: fetch, then run the main job (`tendril reproduce ...`).
-//! - `cargo xtask test`: fetch, then run the whole test suite.
+//! - `cargo xtask test`: fetch, install the Python protocol clients into `vendor/venv`, then run
+//!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -114,7 +115,27 @@ fn run_main(extra: &[String]) -> Result<(), String> {
 
 /// The whole test suite (what `.ci/run` runs).
 fn run_tests(extra: &[String]) -> Result<(), String> {
-    run(cargo().args(["test", "--workspace", "--all-targets"]).args(extra))
+    let python = python_clients()?;
+    run(cargo().args(["test", "--workspace", "--all-targets"]).args(extra).env("TENDRIL_PYTHON", python))
+}
+
+/// Independent protocol clients the tests run against the virtual devices (tests/python_clients.rs),
+/// pinned: SDU `ur_rtde` (a cp311 manylinux wheel, so the venv needs Python 3.11) and ROBOTIS
+/// `dynamixel-sdk` with its one dependency. Installed once into `vendor/venv`; returns its python.
+const PYTHON_CLIENTS: [&str; 3] = ["ur_rtde==1.6.5", "dynamixel-sdk==4.1.0", "pyserial==3.5"];
+
+fn python_clients() -> Result<PathBuf, String> {
+    let venv = workspace_root().join("vendor/venv");
+    let python = venv.join("bin/python");
+    let stamp = venv.join(format!("tendril-clients-{}", PYTHON_CLIENTS.join("-")));
+    if stamp.is_file() && python.is_file() {
+        return Ok(python);
+    }
+    eprintln!("xtask: installing {} into {}", PYTHON_CLIENTS.join(", "), venv.display());
+    run(Command::new(self::python()).args(["-m", "venv"]).arg(&venv))?;
+    run(Command::new(&python).args(["-m", "pip", "install", "--quiet", "--only-binary=:all:"]).args(PYTHON_CLIENTS))?;
+    std::fs::write(&stamp, "").map_err(|e| format!("{}: {e}", stamp.display()))?;
+    Ok(python)
 }
 
 fn run(cmd: &mut Command) -> Result<(), String> {

@@ -2,5 +2,18 @@
 //!
 //! [`protocol`] holds the sans-IO codecs (bytes in, typed packets out, and back), for both the
 //! client side (our drivers) and the device side (the virtual devices `tendril serve` exposes).
+//! The IO layer around them: [`ur`], [`dxl`], [`interrogator`] (drivers), [`cell`] ([`RealCell`]),
+//! [`limits`] ([`LimitedCell`]), [`serve`] (virtual devices), [`urscript`] (the motion program).
 
+pub mod cell;
+pub mod dxl;
+pub mod interrogator;
+pub mod latency;
+pub mod limits;
 pub mod protocol;
+pub mod serve;
+pub mod ur;
+pub mod urscript;
+
+pub use cell::{RealCell, RealCellConfig};
+pub use limits::{LimitedCell, SafetyLimits};

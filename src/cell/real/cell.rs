@@ -1,0 +1,311 @@
+//! [`RealCell`]: the UR5e, the two MX-106 servos and the HYPERION behind the [`Cell`] trait.
+//!
+//! IO: a small tokio runtime owns the RTDE and peak-stream reader tasks; the control thread reads
+//! their latest samples, writes RTDE inputs (async, driven with `block_on`) and talks to the
+//! Dynamixel bus directly (blocking, bounded). Time is the wall clock since [`Cell::activate`].
+//!
+//! Safety on our side (the controller's and the servos' own limits still apply):
+//! - watchdog: a sensor sample older than `sensor_stale_samples` interrogator periods, or an arm
+//!   sample older than `arm_stale_s`, the arm leaving running/normal mode, or the follow program
+//!   no longer playing (stopped on the pendant), fails `read`; the
+//!   runner then calls [`Cell::deactivate`];
+//! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way;
+//! - `deactivate` (every exit path): enable flag 0 → the URScript program `stopj`s the arm;
+//!   gripper goal = present position with torque ON (holds the object); see [`super::dxl`].
+//!
+//! Joint speed/acceleration limits and the force ceiling are the [`super::limits::LimitedCell`]
+//! decorator's job.
+
+use super::dxl::GripperBus;
+use super::interrogator::{self, PeakFeed};
+use super::protocol::hyperion::FbgWindows;
+use super::protocol::rtde::state::{ROBOT_MODE_RUNNING, RUNTIME_STATE_PLAYING, SAFETY_MODE_NORMAL};
+use super::ur::{self, UrClient};
+use super::urscript::FOLLOW_SCRIPT;
+use crate::hardware::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, Lifecycle, require_state};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Where the devices are and how strict the watchdog is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealCellConfig {
+    /// UR controller host (IP or name).
+    pub ur_host: String,
+    /// RTDE port (30004 on a real controller).
+    pub rtde_port: u16,
+    /// Secondary interface port for the URScript program (30002).
+    pub script_port: u16,
+    /// Dynamixel serial port (`/dev/ttyUSB0`, or the pty `tendril serve` prints).
+    pub dxl_port: String,
+    /// Bus baud rate [bit/s] (MX-106 factory default 57 600).
+    pub dxl_baud: u32,
+    /// Growth motor ID.
+    pub growth_id: u8,
+    /// Twine motor ID.
+    pub twine_id: u8,
+    /// Interrogator host.
+    pub interrogator_host: String,
+    /// HYPERION command port (51971).
+    pub command_port: u16,
+    /// HYPERION peak stream port (51972).
+    pub stream_port: u16,
+    /// Which peaks are FBG1 and FBG2.
+    pub windows: FbgWindows,
+    /// Interrogator sample period [s] (1 kHz on the si255, hardware.md).
+    pub sensor_period_s: f64,
+    /// Watchdog: the sensor sample may be this many periods old before the cell stops [-].
+    /// 5: a few lost samples are tolerated, a stalled stream stops the arm within 5 ms at 1 kHz
+    /// plus one control tick.
+    pub sensor_stale_samples: f64,
+    /// Watchdog on the RTDE stream [s]: 5 periods at 500 Hz.
+    pub arm_stale_s: f64,
+    /// Send the follow program to the controller at configure.
+    pub upload_program: bool,
+    /// Turn Ctrl-C into a clean stop (CLI runs; not in tests).
+    pub handle_ctrl_c: bool,
+}
+
+impl RealCellConfig {
+    /// Defaults for the given hosts and serial port: the devices' standard ports, IDs 1 (growth) and
+    /// 2 (twine) at 57 600 baud, default FBG windows.
+    pub fn new(ur_host: &str, dxl_port: &str, interrogator_host: &str) -> RealCellConfig {
+        RealCellConfig {
+            ur_host: ur_host.into(),
+            rtde_port: 30004,
+            script_port: 30002,
+            dxl_port: dxl_port.into(),
+            dxl_baud: 57_600,
+            growth_id: 1,
+            twine_id: 2,
+            interrogator_host: interrogator_host.into(),
+            command_port: 51971,
+            stream_port: 51972,
+            windows: FbgWindows::default(),
+            sensor_period_s: 1e-3,
+            sensor_stale_samples: 5.0,
+            arm_stale_s: 0.01,
+            upload_program: true,
+            handle_ctrl_c: false,
+        }
+    }
+}
+
+struct Devices {
+    ur: UrClient,
+    gripper: GripperBus,
+    peaks: Arc<Mutex<PeakFeed>>,
+    peak_task: tokio::task::JoinHandle<()>,
+}
+
+/// The real gripping cell.
+pub struct RealCell {
+    config: RealCellConfig,
+    runtime: Option<tokio::runtime::Runtime>,
+    devices: Option<Devices>,
+    lifecycle: Lifecycle,
+    started: Instant,
+    stop: Arc<AtomicBool>,
+    last_arm_q: Option<[f64; ARM_JOINTS]>,
+    /// Serial number and channel count read at configure.
+    pub identity: Option<interrogator::Identity>,
+}
+
+fn device(name: &str, cause: impl std::fmt::Display) -> CellError {
+    CellError::Device { device: name.into(), cause: cause.to_string() }
+}
+
+impl RealCell {
+    /// A cell for `config`; nothing is contacted until [`Cell::configure`].
+    pub fn new(config: RealCellConfig) -> RealCell {
+        RealCell {
+            config,
+            runtime: None,
+            devices: None,
+            lifecycle: Lifecycle::Unconfigured,
+            started: Instant::now(),
+            stop: Arc::new(AtomicBool::new(false)),
+            last_arm_q: None,
+            identity: None,
+        }
+    }
+
+    /// A flag that makes the next `read` fail (an operator stop); shared with signal handlers.
+    pub fn stop_flag(&self) -> Arc<AtomicBool> {
+        self.stop.clone()
+    }
+
+    fn parts(&mut self) -> (&tokio::runtime::Runtime, &mut Devices) {
+        let rt = self.runtime.as_ref().expect("configured: the lifecycle checks guarantee it");
+        let d = self.devices.as_mut().expect("configured: the lifecycle checks guarantee it");
+        (rt, d)
+    }
+
+    fn connect(&mut self) -> Result<(), CellError> {
+        let c = self.config.clone();
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .enable_all()
+            .build()
+            .map_err(|e| CellError::Configure(format!("tokio runtime: {e}")))?;
+        let ur_addr = format!("{}:{}", c.ur_host, c.rtde_port);
+        let script_addr = format!("{}:{}", c.ur_host, c.script_port);
+        let cmd_addr = format!("{}:{}", c.interrogator_host, c.command_port);
+        let stream_addr = format!("{}:{}", c.interrogator_host, c.stream_port);
+        let (ur, identity, (peaks, peak_task)) = runtime
+            .block_on(async {
+                let ur = UrClient::connect(&ur_addr).await?;
+                if c.upload_program {
+                    ur::upload_program(&script_addr, FOLLOW_SCRIPT).await?;
+                }
+                let identity = interrogator::identify(&cmd_addr, &c.windows).await?;
+                let stream = interrogator::stream(&stream_addr, c.windows).await?;
+                Ok::<_, String>((ur, identity, stream))
+            })
+            .map_err(CellError::Configure)?;
+        if c.handle_ctrl_c {
+            let stop = self.stop.clone();
+            runtime.spawn(async move {
+                if tokio::signal::ctrl_c().await.is_ok() {
+                    stop.store(true, Ordering::SeqCst);
+                }
+            });
+        }
+        let gripper =
+            GripperBus::open(&c.dxl_port, c.dxl_baud, c.growth_id, c.twine_id).map_err(CellError::Configure)?;
+        self.identity = Some(identity);
+        self.runtime = Some(runtime);
+        self.devices = Some(Devices { ur, gripper, peaks, peak_task });
+        // The first samples of both streams must arrive before the cell counts as configured.
+        let deadline = Instant::now() + Duration::from_secs(2);
+        loop {
+            let d = self.devices.as_ref().expect("just set");
+            let arm = d.ur.latest().map_err(CellError::Configure)?;
+            let sensor = d.peaks.lock().unwrap_or_else(|p| p.into_inner()).latest.is_some();
+            // The follow program must be playing before the cell may move the arm.
+            if let Some((s, _)) = arm
+                && sensor
+                && (s.runtime_state == RUNTIME_STATE_PLAYING || !c.upload_program)
+            {
+                self.last_arm_q = Some(s.q);
+                return Ok(());
+            }
+            if Instant::now() > deadline {
+                return Err(CellError::Configure(
+                    "within 2 s of connecting: no RTDE or peak data, or the follow program is not playing".into(),
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+}
+
+impl Cell for RealCell {
+    fn backend(&self) -> &str {
+        "real"
+    }
+
+    fn lifecycle(&self) -> Lifecycle {
+        self.lifecycle
+    }
+
+    fn configure(&mut self) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Unconfigured, "configure")?;
+        self.connect()?;
+        self.lifecycle = Lifecycle::Inactive;
+        Ok(())
+    }
+
+    fn activate(&mut self) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Inactive, "activate")?;
+        self.started = Instant::now();
+        self.lifecycle = Lifecycle::Active;
+        Ok(())
+    }
+
+    fn deactivate(&mut self) -> Result<(), CellError> {
+        if self.lifecycle != Lifecycle::Active {
+            return Ok(());
+        }
+        self.lifecycle = Lifecycle::Inactive;
+        let q = self.last_arm_q.unwrap_or([0.0; ARM_JOINTS]);
+        let (rt, d) = self.parts();
+        // Both stops are attempted even if the first fails.
+        let arm = rt.block_on(d.ur.send(q, false)).map_err(|e| device("UR5e", e));
+        let hand = d.gripper.hold().map_err(|e| device("MX-106", e));
+        arm.and(hand)
+    }
+
+    fn read(&mut self) -> Result<CellState, CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "read")?;
+        if self.stop.load(Ordering::SeqCst) {
+            return Err(device("operator", "stop requested (Ctrl-C)"));
+        }
+        let time_s = self.started.elapsed().as_secs_f64();
+        let sensor_stale = Duration::from_secs_f64(self.config.sensor_period_s * self.config.sensor_stale_samples);
+        let arm_stale = Duration::from_secs_f64(self.config.arm_stale_s);
+        let upload = self.config.upload_program;
+        let (_, d) = self.parts();
+        let (arm, age) = d.ur.latest().map_err(|e| device("UR5e", e))?.ok_or_else(|| device("UR5e", "no data"))?;
+        if age > arm_stale {
+            return Err(device("UR5e", format!("watchdog: last RTDE sample {:.1} ms old", age.as_secs_f64() * 1e3)));
+        }
+        if arm.robot_mode != ROBOT_MODE_RUNNING || arm.safety_mode != SAFETY_MODE_NORMAL {
+            return Err(device("UR5e", format!("robot mode {} safety mode {}", arm.robot_mode, arm.safety_mode)));
+        }
+        if upload && arm.runtime_state != RUNTIME_STATE_PLAYING {
+            return Err(device("UR5e", format!("follow program not playing (runtime state {})", arm.runtime_state)));
+        }
+        let wavelengths = {
+            let feed = d.peaks.lock().unwrap_or_else(|p| p.into_inner());
+            if let Some(why) = &feed.closed {
+                return Err(device("HYPERION", why));
+            }
+            let (w, at, _) = feed.latest.ok_or_else(|| device("HYPERION", "no data"))?;
+            let age = at.elapsed();
+            if age > sensor_stale {
+                return Err(device(
+                    "HYPERION",
+                    format!("watchdog: last peak sample {:.1} ms old", age.as_secs_f64() * 1e3),
+                ));
+            }
+            w
+        };
+        let [growth, twine] = d.gripper.present_rad().map_err(|e| device("MX-106", e))?;
+        self.last_arm_q = Some(arm.q);
+        Ok(CellState { time_s, arm_q: arm.q, growth_motor_rad: growth, twine_motor_rad: twine, wavelengths })
+    }
+
+    fn write(&mut self, c: &CellCommand) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "write")?;
+        if c.arm_q.iter().chain([&c.growth_motor_rad, &c.twine_motor_rad]).any(|v| !v.is_finite()) {
+            return Err(device("command", format!("non-finite target {c:?}")));
+        }
+        let (rt, d) = self.parts();
+        rt.block_on(d.ur.send(c.arm_q, true)).map_err(|e| device("UR5e", e))?;
+        d.gripper.set_goal_rad([c.growth_motor_rad, c.twine_motor_rad]).map_err(|e| device("MX-106", e))
+    }
+
+    fn wait_until(&mut self, time_s: f64) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "wait")?;
+        let deadline = self.started + Duration::from_secs_f64(time_s.max(0.0));
+        let now = Instant::now();
+        if deadline > now {
+            std::thread::sleep(deadline - now);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for RealCell {
+    fn drop(&mut self) {
+        let _ = self.deactivate();
+        if let Some(d) = self.devices.take() {
+            d.peak_task.abort();
+            drop(d);
+        }
+        if let Some(rt) = self.runtime.take() {
+            rt.shutdown_background();
+        }
+    }
+}

@@ -1,0 +1,144 @@
+//! Virtual devices: the twin ([`SimCell`] stepped in real time) behind the real protocols.
+//!
+//! - RTDE on `rtde_port` (30004) and the URScript secondary interface on `script_port` (30002): the
+//!   virtual controller "runs" an uploaded program by doing what `follow.script` does (follow
+//!   `input_double_register_24..29` while `input_int_register_24` = 1, else hold); see
+//!   [`crate::cell::real::urscript`].
+//! - Dynamixel: MX-106 IDs 1 (growth) and 2 (twine) on a pseudo-terminal (its path in
+//!   [`ServeHandle::pty_path`]); Goal Position drives the twin's motors, Present Position reports them.
+//! - HYPERION: commands on `command_port` (51971), one peak frame per twin tick on `stream_port`
+//!   (51972); FBG1 and FBG2 on channel 1.
+//!
+//! Malformed input: RTDE and HYPERION connections are closed on a framing error (after the
+//! device's error reply where the protocol has one); the bus drops corrupt packets as a device does.
+//! Nothing here panics on input.
+
+mod net;
+mod twin;
+
+use crate::run::scenario::PickPlaceScenario;
+use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+pub use twin::{DeviceState, TwinStatus};
+
+/// Where the virtual devices listen and how fast the twin runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ServeConfig {
+    /// Address to bind (loopback unless asked otherwise).
+    pub bind: IpAddr,
+    /// RTDE port.
+    pub rtde_port: u16,
+    /// URScript secondary interface port.
+    pub script_port: u16,
+    /// HYPERION command port.
+    pub command_port: u16,
+    /// HYPERION peak stream port.
+    pub stream_port: u16,
+    /// Twin tick [s]: the RTDE output and peak stream period. 1 ms = the si255's 1 kHz scan rate.
+    pub period_s: f64,
+    /// SCHED_FIFO priority of the twin, bus and network threads (0: normal scheduling). The
+    /// virtual devices stand in for dedicated hardware; on a shared machine this keeps them from
+    /// waiting behind other processes. Needs root or CAP_SYS_NICE.
+    pub rt_priority: i32,
+}
+
+impl ServeConfig {
+    /// The real devices' ports on 127.0.0.1.
+    pub fn loopback() -> ServeConfig {
+        ServeConfig {
+            bind: IpAddr::V4(Ipv4Addr::LOCALHOST),
+            rtde_port: 30004,
+            script_port: 30002,
+            command_port: 51971,
+            stream_port: 51972,
+            period_s: 1e-3,
+            rt_priority: 0,
+        }
+    }
+
+    /// Ports `base`, `base+1`, `base+2`, `base+3` for RTDE, URScript, HYPERION commands and stream
+    /// (tests and benchmarks use distinct bases so they never collide).
+    pub fn with_port_base(mut self, base: u16) -> ServeConfig {
+        self.rtde_port = base;
+        self.script_port = base + 1;
+        self.command_port = base + 2;
+        self.stream_port = base + 3;
+        self
+    }
+}
+
+/// The running virtual devices; dropping it stops them.
+pub struct ServeHandle {
+    /// Path of the Dynamixel pseudo-terminal.
+    pub pty_path: PathBuf,
+    /// Addresses bound: RTDE, URScript, HYPERION commands, HYPERION stream.
+    pub addrs: [SocketAddr; 4],
+    /// The devices' shared state (for tests comparing with the twin).
+    pub state: Arc<std::sync::Mutex<DeviceState>>,
+    stop: Arc<AtomicBool>,
+    twin: Option<std::thread::JoinHandle<Result<(), String>>>,
+    bus: Option<std::thread::JoinHandle<()>>,
+    runtime: Option<tokio::runtime::Runtime>,
+}
+
+impl ServeHandle {
+    /// Whether the twin still runs (false after a physics failure or `stop`).
+    pub fn running(&self) -> bool {
+        self.twin.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
+    /// Stops everything and returns the twin's error, if it failed.
+    pub fn stop(mut self) -> Result<(), String> {
+        self.shutdown()
+    }
+
+    fn shutdown(&mut self) -> Result<(), String> {
+        self.stop.store(true, Ordering::SeqCst);
+        if let Some(rt) = self.runtime.take() {
+            rt.shutdown_background();
+        }
+        if let Some(b) = self.bus.take() {
+            let _ = b.join();
+        }
+        match self.twin.take().map(|t| t.join()) {
+            Some(Ok(r)) => r,
+            Some(Err(_)) => Err("twin thread panicked".into()),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for ServeHandle {
+    fn drop(&mut self) {
+        let _ = self.shutdown();
+    }
+}
+
+/// Starts the twin and the virtual devices. Returns once everything listens.
+pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Result<ServeHandle> {
+    anyhow::ensure!(config.period_s > 0.0 && config.period_s <= 0.01, "twin period must be in (0, 10 ms]");
+    let stop = Arc::new(AtomicBool::new(false));
+    let (state, ticks) = twin::shared_state()?;
+    let rt = config.rt_priority;
+    if rt > 0 {
+        // Fail early and clearly rather than in each thread.
+        let probe = std::thread::spawn(move || crate::cell::real::latency::set_realtime_priority(rt));
+        probe.join().map_err(|_| anyhow::anyhow!("priority probe panicked"))??;
+    }
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .on_thread_start(move || {
+            if rt > 0 {
+                let _ = crate::cell::real::latency::set_realtime_priority(rt);
+            }
+        })
+        .build()?;
+    let addrs = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe()))?;
+    let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone(), rt)?;
+    let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone(), rt)?;
+    Ok(ServeHandle { pty_path, addrs, state, stop, twin: Some(twin), bus: Some(bus), runtime: Some(runtime) })
+}

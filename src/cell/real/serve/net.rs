@@ -1,0 +1,183 @@
+//! The TCP side of the virtual devices: RTDE, URScript upload, HYPERION commands and stream.
+
+use super::ServeConfig;
+use super::twin::DeviceState;
+use crate::cell::real::protocol::rtde::{ServerConfig, ServerSession};
+use crate::cell::real::urscript::is_complete_program;
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::{TcpListener, TcpStream};
+use tokio::sync::watch;
+
+/// Largest URScript program accepted [bytes].
+const MAX_PROGRAM_LEN: usize = 1 << 20;
+/// A client sending more than this without completing a frame is dropped [bytes].
+const MAX_PENDING: usize = 1 << 20;
+
+type Shared = Arc<Mutex<DeviceState>>;
+
+fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
+    state.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Binds the four listeners and spawns their accept loops; returns the bound addresses.
+pub async fn listen_all(
+    c: &ServeConfig,
+    state: Shared,
+    ticks: watch::Receiver<u64>,
+) -> anyhow::Result<[SocketAddr; 4]> {
+    let bind = |port| async move {
+        TcpListener::bind(SocketAddr::new(c.bind, port))
+            .await
+            .map_err(|e| anyhow::anyhow!("cannot listen on {}:{port}: {e}", c.bind))
+    };
+    let rtde = bind(c.rtde_port).await?;
+    let script = bind(c.script_port).await?;
+    let command = bind(c.command_port).await?;
+    let stream = bind(c.stream_port).await?;
+    let addrs = [rtde.local_addr()?, script.local_addr()?, command.local_addr()?, stream.local_addr()?];
+    {
+        let (state, ticks) = (state.clone(), ticks.clone());
+        tokio::spawn(accept(rtde, move |s| serve_rtde(s, state.clone(), ticks.clone())));
+    }
+    {
+        let state = state.clone();
+        tokio::spawn(accept(script, move |s| serve_script(s, state.clone())));
+    }
+    {
+        let state = state.clone();
+        tokio::spawn(accept(command, move |s| serve_commands(s, state.clone())));
+    }
+    tokio::spawn(accept(stream, move |s| serve_stream(s, state.clone(), ticks.clone())));
+    Ok(addrs)
+}
+
+async fn accept<F, Fut>(listener: TcpListener, handler: F)
+where
+    F: Fn(TcpStream) -> Fut,
+    Fut: std::future::Future<Output = ()> + Send + 'static,
+{
+    loop {
+        match listener.accept().await {
+            Ok((socket, _)) => {
+                let _ = socket.set_nodelay(true);
+                tokio::spawn(handler(socket));
+            }
+            // Out of descriptors and the like: back off instead of spinning.
+            Err(_) => tokio::time::sleep(Duration::from_millis(50)).await,
+        }
+    }
+}
+
+/// One RTDE connection: replies to requests; data packages on each twin tick while started.
+async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>) {
+    let id = {
+        let mut s = lock(&state);
+        s.next_session += 1;
+        s.next_session
+    };
+    let mut session = ServerSession::new(id, ServerConfig::default());
+    let mut buf = Vec::new();
+    let mut chunk = vec![0u8; 16 * 1024];
+    loop {
+        let out = tokio::select! {
+            r = socket.read(&mut chunk) => match r {
+                Ok(n) if n > 0 => {
+                    buf.extend_from_slice(&chunk[..n]);
+                    let mut s = lock(&state);
+                    match session.feed(&mut buf, &mut s.inputs) {
+                        Ok(out) if buf.len() <= MAX_PENDING => out,
+                        _ => break, // malformed or oversized: close, as the controller does
+                    }
+                }
+                _ => break,
+            },
+            changed = ticks.changed() => {
+                if changed.is_err() {
+                    break;
+                }
+                let s = lock(&state);
+                let now = s.outputs.timestamp_s;
+                let packets = session.poll_outputs(now, &s.outputs, &s.inputs);
+                let mut out = Vec::new();
+                for p in packets {
+                    if let Ok(bytes) = p.encode() {
+                        out.extend_from_slice(&bytes);
+                    }
+                }
+                out
+            }
+        };
+        if !out.is_empty() && socket.write_all(&out).await.is_err() {
+            break;
+        }
+    }
+    lock(&state).inputs.release(id);
+}
+
+/// The secondary interface: a complete `def ... end` program starts following.
+async fn serve_script(mut socket: TcpStream, state: Shared) {
+    let mut text = Vec::new();
+    let mut chunk = [0u8; 4096];
+    loop {
+        let read = tokio::time::timeout(Duration::from_secs(2), socket.read(&mut chunk)).await;
+        match read {
+            Ok(Ok(n)) if n > 0 && text.len() + n <= MAX_PROGRAM_LEN => text.extend_from_slice(&chunk[..n]),
+            _ => break,
+        }
+        if let Ok(t) = std::str::from_utf8(&text)
+            && is_complete_program(t)
+        {
+            break;
+        }
+    }
+    if std::str::from_utf8(&text).is_ok_and(is_complete_program) {
+        lock(&state).program_loaded = true;
+    }
+}
+
+/// HYPERION commands: one reply per request; a malformed request closes the connection.
+async fn serve_commands(mut socket: TcpStream, state: Shared) {
+    let mut buf = Vec::new();
+    let mut chunk = [0u8; 4096];
+    loop {
+        match socket.read(&mut chunk).await {
+            Ok(n) if n > 0 => buf.extend_from_slice(&chunk[..n]),
+            _ => return,
+        }
+        let reply = lock(&state).interrogator.feed(&mut buf);
+        match reply {
+            Ok(out) => {
+                if !out.is_empty() && socket.write_all(&out).await.is_err() {
+                    return;
+                }
+            }
+            Err(_) => return,
+        }
+    }
+}
+
+/// HYPERION peak stream: the latest frame after each twin tick (a slow reader skips frames,
+/// which its serial-number check reports).
+async fn serve_stream(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>) {
+    while ticks.changed().await.is_ok() {
+        let frame = {
+            let s = lock(&state);
+            let (on, _) = s.interrogator.streaming();
+            if !on {
+                continue;
+            }
+            s.interrogator.stream_frame()
+        };
+        match frame {
+            Ok(bytes) => {
+                if socket.write_all(&bytes).await.is_err() {
+                    return;
+                }
+            }
+            Err(_) => return,
+        }
+    }
+}

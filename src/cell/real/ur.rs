@@ -1,0 +1,224 @@
+//! UR5e driver: RTDE client on 30004 (thin async IO over the sans-IO [`ClientSession`]) and the
+//! motion program upload on 30002.
+//!
+//! A reader task decodes the 500 Hz output stream into the latest [`ArmSample`]; the control
+//! thread writes the targets and the enable flag as one input data package per tick.
+
+use super::protocol::rtde::{ClientEvent, ClientSession, RtdeValue};
+use super::urscript;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::TcpStream;
+use tokio::net::tcp::OwnedWriteHalf;
+
+/// Output fields requested, in recipe order (the names [`ArmSample`] is decoded from).
+pub const OUTPUT_NAMES: [&str; 7] =
+    ["timestamp", "actual_q", "actual_qd", "actual_TCP_pose", "robot_mode", "safety_mode", "runtime_state"];
+
+/// RTDE output rate [Hz]: the e-Series maximum.
+pub const OUTPUT_RATE_HZ: f64 = 500.0;
+
+/// How long each set-up reply may take.
+const SETUP_TIMEOUT: Duration = Duration::from_secs(3);
+
+/// One decoded output package.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArmSample {
+    /// Controller time [s].
+    pub timestamp_s: f64,
+    /// Joint positions [rad].
+    pub q: [f64; 6],
+    /// Joint velocities [rad/s].
+    pub qd: [f64; 6],
+    /// TCP pose (m, rotation vector rad).
+    pub tcp_pose: [f64; 6],
+    /// Robot mode (7 running).
+    pub robot_mode: i32,
+    /// Safety mode (1 normal).
+    pub safety_mode: i32,
+    /// Runtime state (2 playing).
+    pub runtime_state: u32,
+}
+
+/// The reader task's view: the latest sample, when it arrived, and the error that ended the stream.
+#[derive(Debug, Default)]
+pub struct ArmFeed {
+    /// Latest sample and its arrival time.
+    pub latest: Option<(ArmSample, Instant)>,
+    /// Why the stream ended, if it did.
+    pub closed: Option<String>,
+}
+
+/// A connected, started RTDE session.
+pub struct UrClient {
+    session: ClientSession,
+    writer: OwnedWriteHalf,
+    input_recipe: u8,
+    /// Shared with the reader task.
+    pub feed: Arc<Mutex<ArmFeed>>,
+    reader: tokio::task::JoinHandle<()>,
+}
+
+fn err(cause: impl std::fmt::Display) -> String {
+    format!("RTDE: {cause}")
+}
+
+impl UrClient {
+    /// Connects, negotiates version 2, sets up the output and input recipes and starts streaming.
+    pub async fn connect(addr: &str) -> Result<UrClient, String> {
+        let stream = tokio::time::timeout(SETUP_TIMEOUT, TcpStream::connect(addr))
+            .await
+            .map_err(|_| err(format!("{addr}: connect timed out")))?
+            .map_err(|e| err(format!("{addr}: {e}")))?;
+        stream.set_nodelay(true).map_err(err)?;
+        let (mut reader, mut writer) = stream.into_split();
+        let mut session = ClientSession::new();
+        let mut buf = Vec::new();
+
+        let packet = session.request_protocol_version();
+        let ev = request(&mut session, &mut reader, &mut writer, &mut buf, packet.encode().map_err(err)?).await?;
+        if ev != (ClientEvent::ProtocolVersion { accepted: true }) {
+            return Err(err("protocol version 2 refused"));
+        }
+        let packet = session.request_controller_version();
+        request(&mut session, &mut reader, &mut writer, &mut buf, packet.encode().map_err(err)?).await?;
+        let packet = session.setup_outputs(OUTPUT_RATE_HZ, &OUTPUT_NAMES).map_err(err)?;
+        let ev = request(&mut session, &mut reader, &mut writer, &mut buf, packet.encode().map_err(err)?).await?;
+        let output_recipe = match ev {
+            ClientEvent::OutputRecipe(r) => r.id,
+            other => return Err(err(format!("unexpected reply to output setup: {other:?}"))),
+        };
+        let names = urscript::input_names();
+        let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        let packet = session.setup_inputs(&refs).map_err(err)?;
+        let ev = request(&mut session, &mut reader, &mut writer, &mut buf, packet.encode().map_err(err)?).await?;
+        let input_recipe = match ev {
+            ClientEvent::InputRecipe(r) => r.id,
+            other => return Err(err(format!("unexpected reply to input setup: {other:?}"))),
+        };
+        let mut client_session = session.clone();
+        let packet = session.start();
+        let ev = request(&mut session, &mut reader, &mut writer, &mut buf, packet.encode().map_err(err)?).await?;
+        if ev != (ClientEvent::Started { accepted: true }) {
+            return Err(err("start refused"));
+        }
+        client_session.handle(super::protocol::rtde::ServerPacket::Start { accepted: true }).map_err(err)?;
+        let feed = Arc::new(Mutex::new(ArmFeed::default()));
+        let reader = tokio::spawn(read_outputs(reader, buf, client_session, output_recipe, feed.clone()));
+        Ok(UrClient { session, writer, input_recipe, feed, reader })
+    }
+
+    /// Writes the six targets [rad] and the enable flag in one data package.
+    pub async fn send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
+        let mut values: Vec<RtdeValue> = q.iter().map(|&v| RtdeValue::Double(v)).collect();
+        values.push(RtdeValue::Int32(i32::from(enable)));
+        let packet = self.session.input_data(self.input_recipe, &values).map_err(err)?;
+        self.writer.write_all(&packet.encode().map_err(err)?).await.map_err(err)
+    }
+
+    /// The latest sample and its age, or why the stream ended.
+    pub fn latest(&self) -> Result<Option<(ArmSample, Duration)>, String> {
+        let feed = self.feed.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(why) = &feed.closed {
+            return Err(err(why));
+        }
+        Ok(feed.latest.map(|(s, at)| (s, at.elapsed())))
+    }
+}
+
+impl Drop for UrClient {
+    fn drop(&mut self) {
+        self.reader.abort();
+    }
+}
+
+/// Sends one request and waits for its reply (text messages in between are skipped).
+async fn request(
+    session: &mut ClientSession,
+    reader: &mut tokio::net::tcp::OwnedReadHalf,
+    writer: &mut OwnedWriteHalf,
+    buf: &mut Vec<u8>,
+    bytes: Vec<u8>,
+) -> Result<ClientEvent, String> {
+    writer.write_all(&bytes).await.map_err(err)?;
+    let deadline = tokio::time::Instant::now() + SETUP_TIMEOUT;
+    loop {
+        let mut events = session.feed(buf).map_err(err)?.into_iter();
+        if let Some(ev) = events.find(|e| !matches!(e, ClientEvent::Message(_) | ClientEvent::Data { .. })) {
+            return Ok(ev);
+        }
+        let mut chunk = [0u8; 4096];
+        let n = tokio::time::timeout_at(deadline, reader.read(&mut chunk))
+            .await
+            .map_err(|_| err("no reply within 3 s"))?
+            .map_err(err)?;
+        if n == 0 {
+            return Err(err("controller closed the connection"));
+        }
+        buf.extend_from_slice(&chunk[..n]);
+    }
+}
+
+/// The reader task: decodes data packages until the stream ends.
+async fn read_outputs(
+    mut reader: tokio::net::tcp::OwnedReadHalf,
+    mut buf: Vec<u8>,
+    mut session: ClientSession,
+    recipe: u8,
+    feed: Arc<Mutex<ArmFeed>>,
+) {
+    let mut chunk = vec![0u8; 64 * 1024];
+    let why = loop {
+        match session.feed(&mut buf) {
+            Ok(events) => {
+                let latest = events.into_iter().rev().find_map(|e| match e {
+                    ClientEvent::Data { recipe_id, values } if recipe_id == recipe => decode_sample(&values),
+                    _ => None,
+                });
+                if let Some(s) = latest {
+                    feed.lock().unwrap_or_else(|p| p.into_inner()).latest = Some((s, Instant::now()));
+                }
+            }
+            Err(e) => break e.to_string(),
+        }
+        match reader.read(&mut chunk).await {
+            Ok(0) => break "controller closed the connection".to_string(),
+            Ok(n) => buf.extend_from_slice(&chunk[..n]),
+            Err(e) => break e.to_string(),
+        }
+    };
+    feed.lock().unwrap_or_else(|p| p.into_inner()).closed = Some(why);
+}
+
+/// Values in [`OUTPUT_NAMES`] order to a sample; `None` if the types differ.
+pub fn decode_sample(values: &[RtdeValue]) -> Option<ArmSample> {
+    use RtdeValue::*;
+    match values {
+        [Double(t), Vector6d(q), Vector6d(qd), Vector6d(pose), Int32(mode), Int32(safety), Uint32(runtime)] => {
+            Some(ArmSample {
+                timestamp_s: *t,
+                q: *q,
+                qd: *qd,
+                tcp_pose: *pose,
+                robot_mode: *mode,
+                safety_mode: *safety,
+                runtime_state: *runtime,
+            })
+        }
+        _ => None,
+    }
+}
+
+/// Sends the motion program to the secondary interface (30002) and closes the connection.
+pub async fn upload_program(addr: &str, program: &str) -> Result<(), String> {
+    let mut stream = tokio::time::timeout(SETUP_TIMEOUT, TcpStream::connect(addr))
+        .await
+        .map_err(|_| format!("URScript {addr}: connect timed out"))?
+        .map_err(|e| format!("URScript {addr}: {e}"))?;
+    stream.write_all(program.as_bytes()).await.map_err(|e| format!("URScript {addr}: {e}"))?;
+    if !program.ends_with('\n') {
+        stream.write_all(b"\n").await.map_err(|e| format!("URScript {addr}: {e}"))?;
+    }
+    stream.shutdown().await.map_err(|e| format!("URScript {addr}: {e}"))
+}

@@ -1,0 +1,75 @@
+//! `tendril serve`: the twin behind the real devices' protocols.
+
+use super::emit;
+use crate::cell::real::serve::{ServeConfig, start};
+use crate::run::scenario::PickPlaceScenario;
+use crate::scenario::Override;
+use std::net::IpAddr;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+/// Arguments of `tendril serve`.
+#[derive(Debug, clap::Args)]
+pub struct ServeArgs {
+    /// The scenario file (object, sensor, physics of the twin).
+    scenario: PathBuf,
+    /// Address to listen on; loopback unless asked otherwise.
+    #[arg(long, default_value = "127.0.0.1")]
+    bind: IpAddr,
+    /// Ports N (RTDE), N+1 (URScript), N+2 (HYPERION commands), N+3 (peaks) instead of the
+    /// devices' 30004, 30002, 51971, 51972.
+    #[arg(long)]
+    port_base: Option<u16>,
+    /// Stop after this many seconds (default: until Ctrl-C).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Override a scenario value: `--set key.path=value` (repeatable).
+    #[arg(long = "set")]
+    set: Vec<Override>,
+}
+
+pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
+    let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.set)?;
+    let mut config = ServeConfig::loopback();
+    config.bind = a.bind;
+    if let Some(base) = a.port_base {
+        config = config.with_port_base(base);
+    }
+    let handle = start(&scenario, &config)?;
+    let [rtde, script, command, stream] = handle.addrs;
+    emit(&format!(
+        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {script}\n  HYPERION  {command} (commands), {stream} (peaks)\n  Dynamixel {} (MX-106 IDs 1 growth, 2 twine)\n",
+        scenario.name,
+        handle.pty_path.display()
+    ));
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+        std::thread::spawn(move || {
+            rt.block_on(async {
+                let _ = tokio::signal::ctrl_c().await;
+            });
+            stop.store(true, std::sync::atomic::Ordering::SeqCst);
+        });
+    }
+    let started = std::time::Instant::now();
+    while !stop.load(std::sync::atomic::Ordering::SeqCst) && handle.running() {
+        if a.seconds.is_some_and(|s| started.elapsed().as_secs_f64() >= s) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = handle.state.lock().map(|s| s.status).unwrap_or_default();
+    emit(&format!(
+        "twin ran {:.2} s in {:.2} s wall ({} ticks)\n",
+        status.time_s,
+        started.elapsed().as_secs_f64(),
+        status.ticks
+    ));
+    match handle.stop() {
+        Ok(()) => Ok(ExitCode::SUCCESS),
+        Err(e) => Err(anyhow::anyhow!("twin stopped: {e}")),
+    }
+}

@@ -1,0 +1,78 @@
+//! Independent clients from PyPI against the virtual devices: SDU `ur_rtde` reads `actual_q`
+//! from the virtual UR5e, ROBOTIS `dynamixel-sdk` pings the virtual MX-106 and writes/reads Goal
+//! and Present Position over the pseudo-terminal.
+//!
+//! `cargo xtask test` installs both (pinned) in `vendor/venv` and sets `TENDRIL_PYTHON`; under a
+//! plain `cargo test` these tests say loudly that they are skipped.
+
+use std::net::{IpAddr, Ipv4Addr};
+use std::process::Command;
+use tendril::cell::real::serve::{ServeConfig, start};
+use tendril::run::scenario::PickPlaceScenario;
+
+fn python() -> Option<String> {
+    match std::env::var("TENDRIL_PYTHON") {
+        Ok(p) if !p.is_empty() => Some(p),
+        _ => {
+            eprintln!(
+                "SKIPPED: TENDRIL_PYTHON is not set; run `cargo xtask test` to install ur_rtde and dynamixel-sdk"
+            );
+            None
+        }
+    }
+}
+
+fn scenario() -> PickPlaceScenario {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
+    tendril::scenario::load(&path, &[]).unwrap()
+}
+
+fn run_script(python: &str, script: &str, args: &[&str]) -> serde_json::Value {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/clients").join(script);
+    let out = Command::new(python).arg(path).args(args).output().expect("python runs");
+    assert!(
+        out.status.success(),
+        "{script} failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("the script prints JSON")
+}
+
+#[test]
+fn ur_rtde_reads_actual_q_matching_the_twin() {
+    let Some(python) = python() else { return };
+    // ur_rtde always connects to port 30004: a loopback address of its own avoids collisions.
+    let mut config = ServeConfig::loopback().with_port_base(39740);
+    config.bind = IpAddr::V4(Ipv4Addr::new(127, 0, 0, 74));
+    config.rtde_port = 30004;
+    let serve = start(&scenario(), &config).unwrap();
+    let v = run_script(&python, "ur_rtde_receive.py", &["127.0.0.74"]);
+    let twin = serve.state.lock().unwrap().status;
+    serve.stop().unwrap();
+    let q: Vec<f64> = serde_json::from_value(v["q"].clone()).unwrap();
+    assert_eq!(q.len(), 6);
+    // Nobody commands the arm: it holds the home pose, so any recent sample matches the twin's.
+    for (a, b) in q.iter().zip(twin.arm_q) {
+        assert!((a - b).abs() < 1e-3, "ur_rtde q {q:?}, twin {:?}", twin.arm_q);
+    }
+    assert!((q[0] + std::f64::consts::FRAC_PI_2).abs() < 1e-2, "home base joint is -90°: {q:?}");
+    assert_eq!(v["robot_mode"], 7);
+    assert!(v["t"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn dynamixel_sdk_pings_model_321_and_moves_the_growth_motor() {
+    let Some(python) = python() else { return };
+    let serve = start(&scenario(), &ServeConfig::loopback().with_port_base(39750)).unwrap();
+    let pty = serve.pty_path.to_string_lossy().to_string();
+    let goal = 300; // ticks: 0.46 rad, 5.5 mm of finger growth on the 12 mm pinion
+    let v = run_script(&python, "dynamixel_sdk_client.py", &[&pty, &goal.to_string()]);
+    let twin = serve.state.lock().unwrap().status;
+    serve.stop().unwrap();
+    assert_eq!(v["model"], 321);
+    assert_eq!(v["goal"], goal);
+    let present = v["present"].as_i64().unwrap();
+    assert!((present - goal).abs() <= 20, "present {present}, goal {goal}: {v}");
+    assert!((twin.motors_rad[0] - 300.0 * std::f64::consts::TAU / 4096.0).abs() < 0.05, "{twin:?}");
+}
