@@ -72,7 +72,7 @@ fn real_path_against_virtual_devices_matches_the_twin() {
     serve.stop().unwrap();
 
     assert_eq!(real.error, None);
-    assert_eq!(summary.backend, "real");
+    assert_eq!(summary.run.backend, "real");
     assert!(grasped, "the finger never touched the object");
     assert!(longest_no_contact_s < 0.3, "object lost: {longest_no_contact_s:.2} s without contact");
     // Not compared: the sensor-based slip detector's events. On this scenario it flags a "loss"
