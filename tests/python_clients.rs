@@ -10,6 +10,9 @@ use std::process::Command;
 use tendril::cell::real::serve::{ServeConfig, start};
 use tendril::run::scenario::PickPlaceScenario;
 
+mod common;
+use common::one_at_a_time;
+
 fn python() -> Option<String> {
     match std::env::var("TENDRIL_PYTHON") {
         Ok(p) if !p.is_empty() => Some(p),
@@ -41,6 +44,7 @@ fn run_script(python: &str, script: &str, args: &[&str]) -> serde_json::Value {
 
 #[test]
 fn ur_rtde_reads_actual_q_matching_the_twin() {
+    let _turn = one_at_a_time();
     let Some(python) = python() else { return };
     // ur_rtde always connects to port 30004: a loopback address of its own avoids collisions.
     let mut config = ServeConfig::loopback().with_port_base(39740);
@@ -63,6 +67,7 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
 
 #[test]
 fn dynamixel_sdk_pings_model_321_and_moves_the_growth_motor() {
+    let _turn = one_at_a_time();
     let Some(python) = python() else { return };
     let serve = start(&scenario(), &ServeConfig::loopback().with_port_base(39750)).unwrap();
     let pty = serve.pty_path.to_string_lossy().to_string();

@@ -14,6 +14,9 @@ use tendril::run::real::run_on_real;
 use tendril::run::runner::{Outcome, RunReport};
 use tendril::run::scenario::PickPlaceScenario;
 
+mod common;
+use common::one_at_a_time;
+
 fn phase_stats(report: &RunReport, phase: &str) -> (f64, f64) {
     let rows: Vec<_> = report.rows.iter().filter(|r| r.phase.name() == phase).collect();
     assert!(!rows.is_empty(), "no {phase} rows");
@@ -28,6 +31,7 @@ fn phase_stats(report: &RunReport, phase: &str) -> (f64, f64) {
 
 #[test]
 fn real_path_against_virtual_devices_matches_the_twin() {
+    let _turn = one_at_a_time();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
     let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
     let (_, sim) = run_on_twin(&scenario, &Default::default(), None).unwrap();
@@ -93,6 +97,7 @@ fn real_path_against_virtual_devices_matches_the_twin() {
 
 #[test]
 fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
+    let _turn = one_at_a_time();
     use std::io::{Read, Write};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
     let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
@@ -128,6 +133,7 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
 
 #[test]
 fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
+    let _turn = one_at_a_time();
     use tendril::hardware::Cell;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
     let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
@@ -153,6 +159,7 @@ fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
 
 #[test]
 fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
+    let _turn = one_at_a_time();
     use tendril::hardware::{Cell, CellCommand};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
     let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();

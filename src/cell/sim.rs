@@ -86,6 +86,18 @@ impl SimCell {
         }
     }
 
+    /// The cell a pick-and-place scenario describes, over its compiled scene model.
+    pub fn for_scenario(scenario: &crate::run::scenario::PickPlaceScenario, model: Arc<SceneModel>) -> SimCell {
+        SimCell::new(
+            model,
+            scenario.sensor.clone(),
+            scenario.interrogator.clone(),
+            scenario.gripper,
+            scenario.environment,
+            scenario.seed,
+        )
+    }
+
     fn scene(&self) -> &Scene {
         self.scene.as_ref().expect("configured before use: the lifecycle checks guarantee it")
     }

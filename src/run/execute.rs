@@ -3,10 +3,11 @@
 
 use super::runner::{RunReport, run_task};
 use super::scenario::PickPlaceScenario;
-use super::summary::{Gains, RunIdentity, RunSummary};
+use super::summary::RunSummary;
 use super::trace::TraceWriter;
 use crate::cell::physics::{SceneModel, SceneSpec};
 use crate::cell::sim::SimCell;
+use crate::hardware::Cell;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
@@ -39,15 +40,19 @@ pub fn run_on_twin(
     out: Option<&Path>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     let started = std::time::Instant::now();
-    let model = models.get(&scenario.scene_spec())?;
-    let mut cell = SimCell::new(
-        model,
-        scenario.sensor.clone(),
-        scenario.interrogator.clone(),
-        scenario.gripper,
-        scenario.environment,
-        scenario.seed,
-    );
+    let mut cell = SimCell::for_scenario(scenario, models.get(&scenario.scene_spec())?);
+    run_on_cell(&mut cell, scenario, out, started)
+}
+
+/// Runs `scenario` on any cell, writing `trace.csv` and `summary.json` into `out` when given;
+/// the summary names the cell's backend. `started` is when the run's set-up began (its wall time
+/// counts from there).
+pub fn run_on_cell(
+    cell: &mut dyn Cell,
+    scenario: &PickPlaceScenario,
+    out: Option<&Path>,
+    started: std::time::Instant,
+) -> anyhow::Result<(RunSummary, RunReport)> {
     let mut trace = match out {
         Some(dir) => {
             std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
@@ -56,18 +61,8 @@ pub fn run_on_twin(
         }
         None => None,
     };
-    let report = run_task(&mut cell, &scenario.control_plan(), trace.as_mut());
-    let identity = RunIdentity {
-        scenario: scenario.name.clone(),
-        object: scenario.object.name.to_string(),
-        mass_kg: scenario.object.name.paper_mass_kg(),
-        feedback: scenario.feedback,
-        gains: Gains { kp: scenario.controller.kp, ki: scenario.controller.ki, kd: scenario.controller.kd },
-        setpoint_n: scenario.setpoint_n,
-        seed: scenario.seed,
-        backend: "mujoco".into(),
-    };
-    let summary = RunSummary::new(identity, &report, started.elapsed().as_secs_f64());
+    let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
+    let summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
     if let Some(dir) = out {
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")

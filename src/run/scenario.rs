@@ -9,6 +9,7 @@
 //! Everything else has the paper's or the model's documented defaults; see `scenarios/*.toml`.
 
 use super::runner::ControlPlan;
+use super::summary::{Gains, RunIdentity};
 use crate::cell::fbg::{InterrogatorConfig, SensorConfig};
 use crate::cell::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneSpec};
 use crate::cell::sim::EnvironmentConfig;
@@ -126,6 +127,20 @@ impl PickPlaceScenario {
             finger: self.finger.clone(),
             object: Some(self.object.clone()),
             arm_q0: self.task.home_deg.map(f64::to_radians),
+        }
+    }
+
+    /// What identifies a run of this scenario in its summary.
+    pub fn identity(&self, backend: &str) -> RunIdentity {
+        RunIdentity {
+            scenario: self.name.clone(),
+            object: self.object.name.to_string(),
+            mass_kg: self.object.name.paper_mass_kg(),
+            feedback: self.feedback,
+            gains: Gains { kp: self.controller.kp, ki: self.controller.ki, kd: self.controller.kd },
+            setpoint_n: self.setpoint_n,
+            seed: self.seed,
+            backend: backend.into(),
         }
     }
 

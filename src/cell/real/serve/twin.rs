@@ -141,14 +141,7 @@ pub fn spawn(
             let _ = crate::cell::real::latency::set_realtime_priority(rt_priority);
         }
         // Built here: the simulation's data stays on this thread.
-        let mut cell = SimCell::new(
-            model,
-            scenario.sensor.clone(),
-            scenario.interrogator.clone(),
-            scenario.gripper,
-            scenario.environment,
-            scenario.seed,
-        );
+        let mut cell = SimCell::for_scenario(&scenario, model);
         let e = |e: crate::hardware::CellError| e.to_string();
         cell.configure().map_err(e)?;
         cell.activate().map_err(e)?;
