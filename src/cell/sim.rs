@@ -5,7 +5,7 @@
 //! and samples the sensor model at the interrogator's rate with the pad's true contact force.
 
 use super::fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
-use super::physics::{PhysicsError, Scene, SceneModel};
+use super::physics::{PhysicsError, PhysicsReadout, Scene, SceneModel};
 use crate::control::gripper::GripperConfig;
 use crate::hardware::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
 use crate::scenario::{Checker, Validate};
@@ -58,6 +58,9 @@ pub struct SimCell {
     lifecycle: Lifecycle,
     latest: Wavelengths,
     next_sample_s: f64,
+    /// The physics readout after the last step, read once per tick by `read`, the sensor and
+    /// the ground truth alike.
+    readout: PhysicsReadout,
 }
 
 impl SimCell {
@@ -83,6 +86,7 @@ impl SimCell {
             lifecycle: Lifecycle::Unconfigured,
             latest: Wavelengths { fbg1_nm: 0.0, fbg2_nm: 0.0 },
             next_sample_s: 0.0,
+            readout: PhysicsReadout::default(),
         }
     }
 
@@ -113,8 +117,9 @@ impl SimCell {
     /// contact force of the last physics step (zero-order hold over one step).
     fn sample_sensor(&mut self) {
         let dt = 1.0 / self.interrogator.sample_rate_hz;
-        let now = self.scene().time();
-        let force = self.scene().readout().pad_force_n;
+        self.readout = self.scene().readout();
+        let now = self.readout.time_s;
+        let force = self.readout.pad_force_n;
         while self.next_sample_s <= now + 1e-12 {
             let temperature = self.environment.temperature_at(self.next_sample_s);
             self.latest = self.sensor.sample(force, temperature, dt);
@@ -158,7 +163,7 @@ impl Cell for SimCell {
 
     fn read(&mut self) -> Result<CellState, CellError> {
         require_state(self.lifecycle, Lifecycle::Active, "read")?;
-        let r = self.scene().readout();
+        let r = &self.readout;
         Ok(CellState {
             time_s: r.time_s,
             arm_q: r.arm_q,
@@ -191,8 +196,8 @@ impl Cell for SimCell {
     }
 
     fn ground_truth(&self) -> Option<GroundTruth> {
-        let scene = self.scene.as_ref()?;
-        let r = scene.readout();
+        self.scene.as_ref()?;
+        let r = &self.readout;
         Some(GroundTruth {
             sensor_force_n: r.pad_force_n,
             grip_force_n: r.grip_force_n,
