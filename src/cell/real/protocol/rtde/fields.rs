@@ -186,62 +186,63 @@ pub fn input_type(name: &str) -> Option<RtdeType> {
 }
 
 #[cfg(test)]
+/// The 58 names SDU's `ur_rtde` `RTDEReceiveInterface` asks for by default on PolyScope 5.11+.
+pub(crate) fn ur_rtde_default_outputs() -> Vec<String> {
+    let mut names: Vec<String> = [
+        "timestamp",
+        "target_q",
+        "target_qd",
+        "target_qdd",
+        "target_current",
+        "target_moment",
+        "actual_q",
+        "actual_qd",
+        "actual_current",
+        "joint_control_output",
+        "actual_TCP_pose",
+        "actual_TCP_speed",
+        "actual_TCP_force",
+        "target_TCP_pose",
+        "target_TCP_speed",
+        "actual_digital_input_bits",
+        "joint_temperatures",
+        "actual_execution_time",
+        "robot_mode",
+        "joint_mode",
+        "safety_mode",
+        "actual_tool_accelerometer",
+        "speed_scaling",
+        "target_speed_fraction",
+        "actual_momentum",
+        "actual_main_voltage",
+        "actual_robot_voltage",
+        "actual_robot_current",
+        "actual_joint_voltage",
+        "actual_digital_output_bits",
+        "runtime_state",
+        "standard_analog_input0",
+        "standard_analog_input1",
+        "standard_analog_output0",
+        "standard_analog_output1",
+        "robot_status_bits",
+        "safety_status_bits",
+        "ft_raw_wrench",
+        "payload",
+        "payload_cog",
+        "payload_inertia",
+        "output_int_register_2",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    names.extend((12..=19).map(|i| format!("output_int_register_{i}")));
+    names.extend((12..=19).map(|i| format!("output_double_register_{i}")));
+    names
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The 58 names SDU's `ur_rtde` `RTDEReceiveInterface` asks for by default on PolyScope 5.11+.
-    fn ur_rtde_default_outputs() -> Vec<String> {
-        let mut names: Vec<String> = [
-            "timestamp",
-            "target_q",
-            "target_qd",
-            "target_qdd",
-            "target_current",
-            "target_moment",
-            "actual_q",
-            "actual_qd",
-            "actual_current",
-            "joint_control_output",
-            "actual_TCP_pose",
-            "actual_TCP_speed",
-            "actual_TCP_force",
-            "target_TCP_pose",
-            "target_TCP_speed",
-            "actual_digital_input_bits",
-            "joint_temperatures",
-            "actual_execution_time",
-            "robot_mode",
-            "joint_mode",
-            "safety_mode",
-            "actual_tool_accelerometer",
-            "speed_scaling",
-            "target_speed_fraction",
-            "actual_momentum",
-            "actual_main_voltage",
-            "actual_robot_voltage",
-            "actual_robot_current",
-            "actual_joint_voltage",
-            "actual_digital_output_bits",
-            "runtime_state",
-            "standard_analog_input0",
-            "standard_analog_input1",
-            "standard_analog_output0",
-            "standard_analog_output1",
-            "robot_status_bits",
-            "safety_status_bits",
-            "ft_raw_wrench",
-            "payload",
-            "payload_cog",
-            "payload_inertia",
-            "output_int_register_2",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        names.extend((12..=19).map(|i| format!("output_int_register_{i}")));
-        names.extend((12..=19).map(|i| format!("output_double_register_{i}")));
-        names
-    }
 
     #[test]
     fn ur_rtde_defaults_are_all_known() {

@@ -18,69 +18,11 @@ fn decode_all(mut bytes: &[u8]) -> Vec<ServerPacket> {
     packets
 }
 
-/// The 58 default names of ur_rtde's RTDEReceiveInterface (see fields.rs).
-fn ur_rtde_names() -> Vec<String> {
-    let mut names: Vec<String> = super::fields::FIXED_OUTPUTS
-        .iter()
-        .map(|(n, _)| n.to_string())
-        .filter(|n| {
-            [
-                "timestamp",
-                "target_q",
-                "target_qd",
-                "target_qdd",
-                "target_current",
-                "target_moment",
-                "actual_q",
-                "actual_qd",
-                "actual_current",
-                "joint_control_output",
-                "actual_TCP_pose",
-                "actual_TCP_speed",
-                "actual_TCP_force",
-                "target_TCP_pose",
-                "target_TCP_speed",
-                "actual_digital_input_bits",
-                "joint_temperatures",
-                "actual_execution_time",
-                "robot_mode",
-                "joint_mode",
-                "safety_mode",
-                "actual_tool_accelerometer",
-                "speed_scaling",
-                "target_speed_fraction",
-                "actual_momentum",
-                "actual_main_voltage",
-                "actual_robot_voltage",
-                "actual_robot_current",
-                "actual_joint_voltage",
-                "actual_digital_output_bits",
-                "runtime_state",
-                "standard_analog_input0",
-                "standard_analog_input1",
-                "standard_analog_output0",
-                "standard_analog_output1",
-                "robot_status_bits",
-                "safety_status_bits",
-                "ft_raw_wrench",
-                "payload",
-                "payload_cog",
-                "payload_inertia",
-            ]
-            .contains(&n.as_str())
-        })
-        .collect();
-    names.push("output_int_register_2".into());
-    names.extend((12..=19).map(|i| format!("output_int_register_{i}")));
-    names.extend((12..=19).map(|i| format!("output_double_register_{i}")));
-    names
-}
-
 #[test]
 fn ur_rtde_receive_handshake_byte_sequence() {
     let mut server = ServerSession::new(1, ServerConfig::default());
     let mut shared = SharedInputs::new();
-    let names = ur_rtde_names();
+    let names = super::fields::ur_rtde_default_outputs();
     assert_eq!(names.len(), 58);
 
     // What RTDEReceiveInterface sends: V (as 00 02), v, v, O at 500 Hz with a trailing comma, S.
