@@ -340,15 +340,17 @@ impl Chart for TraceChart<'_> {
             SET_C.stroke_width(2),
         ))?;
         let has_truth = pts.iter().any(|p| p.true_force_n.is_finite());
+        // Dense, noisy series are drawn one pixel wide: the bitmap backend joins thick lines with
+        // mitres, which at the sharp reversals of a noisy trace shoot spikes across the chart.
         for line in polylines(pts, |p| p.true_force_n) {
-            fc.draw_series(LineSeries::new(line, TRUE_C.stroke_width(2)))?;
+            fc.draw_series(LineSeries::new(line, TRUE_C.stroke_width(1)))?;
         }
         for line in polylines(pts, |p| p.force_n) {
-            fc.draw_series(LineSeries::new(line, EST_C.stroke_width(2)))?;
+            fc.draw_series(LineSeries::new(line, EST_C.stroke_width(1)))?;
         }
         oc.draw_series(LineSeries::new([(t0, 0.0), (t1, 0.0)], RGBColor(150, 150, 150).stroke_width(1)))?;
         for line in polylines(pts, |p| p.controller_output_deg_s) {
-            oc.draw_series(LineSeries::new(line, OUT_C.stroke_width(2)))?;
+            oc.draw_series(LineSeries::new(line, OUT_C.stroke_width(1)))?;
         }
 
         // Arm start and slip detection: solid lines, named near the bottom of the force panel.
