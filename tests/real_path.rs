@@ -20,6 +20,22 @@ use tendril::run::scenario::PickPlaceScenario;
 mod common;
 use common::one_at_a_time;
 
+/// The short grasp-hold-lift scenario every test here runs.
+fn short_lift() -> PickPlaceScenario {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
+    tendril::scenario::load(&path, &[]).unwrap()
+}
+
+/// A real-cell configuration pointing at the virtual devices of `serve` on loopback.
+fn config_for(serve: &tendril::cell::real::serve::ServeHandle) -> RealCellConfig {
+    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
+    config.rtde_port = serve.addrs[0].port();
+    config.script_port = serve.addrs[1].port();
+    config.command_port = serve.addrs[2].port();
+    config.stream_port = serve.addrs[3].port();
+    config
+}
+
 fn phase_stats(report: &RunReport, phase: &str) -> (f64, f64) {
     let rows: Vec<_> = report.rows.iter().filter(|r| r.phase.name() == phase).collect();
     assert!(!rows.is_empty(), "no {phase} rows");
@@ -35,17 +51,12 @@ fn phase_stats(report: &RunReport, phase: &str) -> (f64, f64) {
 #[test]
 fn real_path_against_virtual_devices_matches_the_twin() {
     let _turn = one_at_a_time();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
-    let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
+    let scenario = short_lift();
     let (_, sim) = run_on_twin(&scenario, &Default::default(), None).unwrap();
     assert_eq!(sim.outcome, Outcome::Held, "the short scenario must hold on the twin: {:?}", sim.error);
 
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39710)).unwrap();
-    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
-    config.rtde_port = serve.addrs[0].port();
-    config.script_port = serve.addrs[1].port();
-    config.command_port = serve.addrs[2].port();
-    config.stream_port = serve.addrs[3].port();
+    let mut config = config_for(&serve);
     // CI shares 2 cores between the twin, the client and the build: a loose watchdog (100 ms)
     // so a scheduling hiccup does not end the run; the watchdog itself is tested below.
     config.sensor_stale_samples = 100.0;
@@ -105,8 +116,7 @@ fn real_path_against_virtual_devices_matches_the_twin() {
 fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
     let _turn = one_at_a_time();
     use std::io::{Read, Write};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
-    let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
+    let scenario = short_lift();
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39720)).unwrap();
     let timeout = Some(std::time::Duration::from_secs(2));
     // RTDE: a size field below the header length.
@@ -141,14 +151,9 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
 fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
     let _turn = one_at_a_time();
     use tendril::hardware::Cell;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
-    let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
+    let scenario = short_lift();
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39730)).unwrap();
-    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
-    config.rtde_port = serve.addrs[0].port();
-    config.script_port = serve.addrs[1].port();
-    config.command_port = serve.addrs[2].port();
-    config.stream_port = serve.addrs[3].port();
+    let config = config_for(&serve);
     let mut cell = tendril::cell::real::RealCell::new(config);
     cell.configure().unwrap();
     cell.activate().unwrap();
@@ -167,14 +172,9 @@ fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
 fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
     let _turn = one_at_a_time();
     use tendril::hardware::{Cell, CellCommand};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
-    let scenario: PickPlaceScenario = tendril::scenario::load(&path, &[]).unwrap();
+    let scenario = short_lift();
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39760)).unwrap();
-    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
-    config.rtde_port = serve.addrs[0].port();
-    config.script_port = serve.addrs[1].port();
-    config.command_port = serve.addrs[2].port();
-    config.stream_port = serve.addrs[3].port();
+    let mut config = config_for(&serve);
     config.sensor_stale_samples = 100.0;
     config.arm_stale_s = 0.1;
     let mut cell = tendril::cell::real::RealCell::new(config);

@@ -68,12 +68,7 @@ fn class(r: &GainMapRow) -> usize {
 
 /// Draws `gain_map_<object>.png/.svg` per object in `out_dir`; returns the files written.
 pub fn render(rows: &[GainMapRow], out_dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    let mut objects: Vec<&str> = Vec::new();
-    for r in rows {
-        if !objects.contains(&r.object.as_str()) {
-            objects.push(&r.object);
-        }
-    }
+    let objects = grid::first_seen(rows.iter().map(|r| r.object.as_str()));
     let mut written = Vec::new();
     for object in objects {
         let runs: Vec<&GainMapRow> = rows.iter().filter(|r| r.object == object).collect();

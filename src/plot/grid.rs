@@ -57,6 +57,17 @@ pub fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {
     v
 }
 
+/// The distinct values in the order they first appear (objects, integrators, groups).
+pub fn first_seen<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out: Vec<T> = Vec::new();
+    for v in values {
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
 /// Index of `v` in sorted distinct `values`.
 pub fn index_of(values: &[f64], v: f64) -> usize {
     values.iter().position(|x| *x == v).unwrap_or(0)

@@ -2,6 +2,7 @@
 //! marker per backend, the Pareto front drawn through the non-dominated settings (faster and
 //! more accurate than any other), the default settings ringed and the reference marked.
 
+use super::grid;
 use super::input::Table;
 use super::style::{self, FONT};
 use super::{Chart, DrawResult, PlotError};
@@ -108,16 +109,6 @@ fn settings(r: &SpeedAccuracyRow) -> String {
     format!("{}, {} links, {}", style::timestep(r.timestep_s), r.segments, r.cone)
 }
 
-fn distinct<'a>(values: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
-    let mut out: Vec<&str> = Vec::new();
-    for v in values {
-        if !out.contains(&v) {
-            out.push(v);
-        }
-    }
-    out
-}
-
 impl SpeedAccuracy {
     /// (row, speed, |drop-time error|) of the settled runs with a drop-time error.
     fn drop_errors(&self) -> Vec<(&SpeedAccuracyRow, f64, f64)> {
@@ -162,8 +153,8 @@ impl SpeedAccuracy {
             .x_label_formatter(&|v| style::num(*v))
             .y_label_formatter(&|v| style::num(*v))
             .draw()?;
-        let integrators = distinct(self.rows.iter().map(|r| r.integrator.as_str()));
-        let backends = distinct(self.rows.iter().map(|r| r.backend.as_str()));
+        let integrators = grid::first_seen(self.rows.iter().map(|r| r.integrator.as_str()));
+        let backends = grid::first_seen(self.rows.iter().map(|r| r.backend.as_str()));
         chart.draw_series(drops.iter().map(|(r, s, e)| {
             let k = integrators.iter().position(|i| *i == r.integrator).unwrap_or(0);
             let m = backends.iter().position(|b| *b == r.backend).unwrap_or(0);
@@ -231,8 +222,8 @@ impl Chart for SpeedAccuracy {
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(60, 60, 60).stroke_width(2)));
 
-        let integrators = distinct(self.rows.iter().map(|r| r.integrator.as_str()));
-        let backends = distinct(self.rows.iter().map(|r| r.backend.as_str()));
+        let integrators = grid::first_seen(self.rows.iter().map(|r| r.integrator.as_str()));
+        let backends = grid::first_seen(self.rows.iter().map(|r| r.backend.as_str()));
         for (k, integrator) in integrators.iter().enumerate() {
             let color = style::SERIES[k % style::SERIES.len()];
             for (m, backend) in backends.iter().enumerate() {

@@ -63,13 +63,7 @@ pub fn largest_stable(rows: &[&StabilityRow]) -> Option<f64> {
 
 /// Draws `stability.png/.svg` in `out_dir`; returns the files written.
 pub fn render(rows: &[StabilityRow], out_dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    let mut groups: Vec<(String, String)> = Vec::new();
-    for r in rows {
-        let g = (r.backend.clone(), r.integrator.clone());
-        if !groups.contains(&g) {
-            groups.push(g);
-        }
-    }
+    let groups = super::grid::first_seen(rows.iter().map(|r| (r.backend.clone(), r.integrator.clone())));
     super::save(&Stability { rows: rows.to_vec(), groups }, out_dir, "stability")
 }
 

@@ -66,12 +66,7 @@ pub fn read(path: &Path) -> Result<Vec<SweepRow>, PlotError> {
 
 /// Draws one figure per object, `sweep_<object>.png/.svg` in `out_dir`; returns the files written.
 pub fn render(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    let mut objects: Vec<&str> = Vec::new();
-    for r in rows {
-        if !objects.contains(&r.object.as_str()) {
-            objects.push(&r.object);
-        }
-    }
+    let objects = grid::first_seen(rows.iter().map(|r| r.object.as_str()));
     let mut written = Vec::new();
     for object in objects {
         let runs: Vec<&SweepRow> = rows.iter().filter(|r| r.object == object).collect();
