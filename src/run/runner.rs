@@ -100,8 +100,9 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
             if sequencer.phase() == Phase::Home {
                 // Tare on the mean of the samples at home, finger retracted and untouched.
                 tare.add(state.wavelengths);
-                estimator.tare(tare.mean());
-                unloaded_n = estimator.estimate(tare.mean()).map_or(0.0, |e| e.force_n);
+                let mean = tare.mean();
+                estimator.tare(mean);
+                unloaded_n = estimator.estimate(mean).map_or(0.0, |e| e.force_n);
                 sequencer.set_unloaded_reading(unloaded_n);
             }
             let estimate = estimator.track(state.wavelengths).map_err(|e| CellError::Device {
