@@ -4,17 +4,19 @@
 //! - `full_scene_kinematic_1s`: the pick-and-place scene with default settings (kinematic arm, 10-segment
 //!   finger with the pad, crimper, table), already grasped, lifting the hand 5 cm in the measured second.
 //! - `full_scene_dynamic_arm_1s`: the same with the six-joint arm dynamics.
-//! - `minimal_box_on_plane_1s`: a box resting on a plane with the same options.
+//! - `full_scene_rapier_1s`: the kinematic-arm scene on the rapier backend.
+//! - `minimal_box_on_plane_1s` (and `_rapier_1s`): a box resting on a plane with the same options.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
-use tendril::cell::physics::{ArmMode, PhysicsConfig, Scene, SceneSpec, ur5e, validation};
+use tendril::cell::physics::validation::ValidationRun;
+use tendril::cell::physics::{ArmMode, Backend, Physics, PhysicsConfig, SceneModel, SceneSpec, ur5e, validation};
 
 /// A scene already holding the object: grown (3.5 s at the motor's speed), twined to 32 mm at a steady
 /// 7.5 mm/s (4.3 s), settled (0.5 s).
-fn grasped(spec: &SceneSpec) -> Scene {
-    let mut s = Scene::build(spec).expect("scene builds");
+fn grasped(spec: &SceneSpec) -> Box<dyn Physics> {
+    let mut s = SceneModel::build(spec).expect("scene builds").start().expect("starts");
     s.set_growth(spec.finger.length_m).unwrap();
     s.run_for(3.5).unwrap();
     let n = (0.032 / 0.0075 / s.timestep()).round() as usize;
@@ -67,19 +69,23 @@ fn physics(c: &mut Criterion) {
     let mut dynamic = SceneSpec::default();
     dynamic.physics.arm_mode = ArmMode::Dynamic;
     bench_scene(c, "full_scene_dynamic_arm_1s", dynamic);
+    let mut rapier = SceneSpec::default();
+    rapier.physics.backend = Backend::Rapier;
+    bench_scene(c, "full_scene_rapier_1s", rapier);
 
-    let p = PhysicsConfig::default();
-    let model = validation::box_on_plane(&p).expect("builds");
-    let steps = (1.0 / p.timestep_s).round() as usize;
-    c.bench_function("minimal_box_on_plane_1s", |b| {
-        b.iter(|| {
-            let mut d = model.make_data();
-            for _ in 0..steps {
-                d.step();
-            }
-            black_box(d.qpos()[2])
-        })
-    });
+    for (name, backend) in
+        [("minimal_box_on_plane_1s", Backend::Mujoco), ("minimal_box_on_plane_rapier_1s", Backend::Rapier)]
+    {
+        let p = PhysicsConfig { backend, ..PhysicsConfig::default() };
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                let model = validation::box_on_plane(&p).expect("builds");
+                let mut run = ValidationRun::new(model, &p).expect("starts");
+                run.run_for(1.0).expect("steps");
+                black_box(run.body_position("box").expect("has a box")[2])
+            })
+        });
+    }
 }
 
 criterion_group! {

@@ -7,19 +7,23 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::path::Path;
 use std::time::{Duration, Instant};
+use tendril::cell::physics::Backend;
 use tendril::run::execute::{ModelCache, run_on_twin};
 use tendril::run::scenario::PickPlaceScenario;
+use tendril::scenario::Override;
 
-fn scenario(name: &str) -> PickPlaceScenario {
+fn scenario(name: &str, backend: Backend) -> PickPlaceScenario {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
-    tendril::scenario::load(&file, &[]).expect("shipped scenarios load")
+    tendril::scenario::load(&file, &[Override::backend(backend)]).expect("shipped scenarios load")
 }
 
 fn full_scenario(c: &mut Criterion) {
     let mut group = c.benchmark_group("scenario");
     group.sample_size(10).measurement_time(Duration::from_secs(20));
-    for name in ["crimper", "shampoo", "hammer"] {
-        let s = scenario(name);
+    let runs = ["crimper", "shampoo", "hammer"].into_iter().flat_map(|n| [(n, Backend::Mujoco), (n, Backend::Rapier)]);
+    for (name, backend) in runs {
+        let s = scenario(name, backend);
+        let name = format!("{name}_{}", backend.name());
         let models = ModelCache::default();
         let (summary, _) = run_on_twin(&s, &models, None).expect("runs");
         let started = Instant::now();
@@ -32,7 +36,7 @@ fn full_scenario(c: &mut Criterion) {
             wall,
             again.sim_time_s / wall
         );
-        group.bench_function(name, |b| b.iter(|| run_on_twin(&s, &models, None).expect("runs")));
+        group.bench_function(&name, |b| b.iter(|| run_on_twin(&s, &models, None).expect("runs")));
     }
     group.finish();
 }

@@ -1,110 +1,124 @@
-//! The physics layer against analytic cases, all with the project's default `[physics]` settings.
+//! The physics layer against analytic cases, with the project's default `[physics]` settings, on
+//! both backends. Each check is one function taking the backend; [`both_backends!`] makes a test of
+//! it per backend. Where the backends' tolerances differ, the table of each test says so.
 
-use mujoco_rs::mujoco_c::_mjtObjBase::{mjOBJ_ACTUATOR, mjOBJ_BODY, mjOBJ_GEOM};
-use mujoco_rs::prelude::{MjData, MjModel};
+use mujoco_rs::mujoco_c::_mjtObjBase::{mjOBJ_BODY, mjOBJ_GEOM};
+use mujoco_rs::prelude::MjModel;
+use tendril::cell::physics::validation::{self, ValidationRun};
 use tendril::cell::physics::{
-    Integrator, ObjectConfig, ObjectName, PhysicsConfig, PhysicsError, Scene, SceneModel, SceneSpec, validation,
+    Backend, Integrator, ObjectConfig, ObjectName, Physics, PhysicsConfig, PhysicsError, Scene, SceneModel, SceneSpec,
 };
 
 const G: f64 = 9.81;
+
+/// `mod mujoco` and `mod rapier`, each with one `#[test]` per named check.
+macro_rules! both_backends {
+    ($($check:ident),* $(,)?) => {
+        mod mujoco {
+            $(#[test] fn $check() { super::$check(tendril::cell::physics::Backend::Mujoco) })*
+        }
+        mod rapier {
+            $(#[test] fn $check() { super::$check(tendril::cell::physics::Backend::Rapier) })*
+        }
+    };
+}
+
+both_backends!(
+    resting_box_normal_force_equals_weight,
+    slope_holds_below_and_slides_above_the_friction_angle,
+    pinch_holding_force_matches_analytic_bound,
+    more_twine_gives_more_grip_and_pad_force,
+    contact_force_relaxes_under_a_fixed_twine,
+    a_loose_grip_lets_the_object_slip_out,
+    same_inputs_give_identical_trajectories,
+    runs_sharing_one_model_across_threads_match_a_sequential_run,
+    an_unstable_setting_is_reported_with_its_time,
+    bad_inputs_are_errors_not_nan,
+    kinematic_arm_puts_the_hand_where_dh_kinematics_says,
+);
+
+fn physics(backend: Backend) -> PhysicsConfig {
+    PhysicsConfig { backend, ..PhysicsConfig::default() }
+}
+
+fn spec(backend: Backend) -> SceneSpec {
+    SceneSpec { physics: physics(backend), ..SceneSpec::default() }
+}
 
 fn body(m: &MjModel, name: &str) -> usize {
     m.name_to_id(mjOBJ_BODY, name).unwrap()
 }
 
-/// Sum of contact normal forces on geom `g` [N].
-fn normal_force_on(d: &MjData<&MjModel>, g: usize) -> f64 {
-    d.contact()
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.geom1 as usize == g || c.geom2 as usize == g)
-        .map(|(i, _)| d.contact_force(i)[0])
-        .sum()
-}
-
-#[test]
-fn resting_box_normal_force_equals_weight() {
-    let p = PhysicsConfig::default();
-    let m = validation::box_on_plane(&p).unwrap();
-    let mut d = m.make_data();
-    for _ in 0..(1.0 / p.timestep_s) as usize {
-        d.step();
-    }
-    let g = m.name_to_id(mjOBJ_GEOM, "box").unwrap();
-    let n = normal_force_on(&d, g);
-    let weight = 1.0 * -m.opt().gravity[2];
-    assert!(((n - weight) / weight).abs() < 1e-3, "normal force {n} N vs m g {weight} N");
+fn resting_box_normal_force_equals_weight(backend: Backend) {
+    let p = physics(backend);
+    let mut run = ValidationRun::new(validation::box_on_plane(&p).unwrap(), &p).unwrap();
+    run.run_for(1.0).unwrap();
+    let n = run.normal_force_on("box").unwrap();
+    let weight = 1.0 * G;
+    assert!(((n - weight) / weight).abs() < 1e-3, "{backend:?}: normal force {n} N vs m g {weight} N");
 }
 
 /// Displacement of the box along the slope after `seconds` [m].
-fn slope_slide(angle_deg: f64, seconds: f64) -> f64 {
-    let p = PhysicsConfig::default();
-    let m = validation::slope(&p, angle_deg.to_radians()).unwrap();
-    let mut d = m.make_data();
-    d.forward();
-    let b = body(&m, "box");
-    let start = d.xpos()[b];
-    for _ in 0..(seconds / p.timestep_s) as usize {
-        d.step();
-    }
-    let end = d.xpos()[b];
+fn slope_slide(p: &PhysicsConfig, angle_deg: f64, seconds: f64) -> f64 {
+    let mut run = ValidationRun::new(validation::slope(p, angle_deg.to_radians()).unwrap(), p).unwrap();
+    let start = run.body_position("box").unwrap();
+    run.run_for(seconds).unwrap();
+    let end = run.body_position("box").unwrap();
     (0..3).map(|k| (end[k] - start[k]).powi(2)).sum::<f64>().sqrt()
 }
 
-#[test]
-fn slope_holds_below_and_slides_above_the_friction_angle() {
+fn slope_holds_below_and_slides_above_the_friction_angle(backend: Backend) {
+    let p = physics(backend);
     let critical = 0.5f64.atan().to_degrees();
-    let held = slope_slide(critical - 0.5, 2.0);
-    assert!(held < 0.5e-3, "box crept {held} m at {:.3} deg", critical - 0.5);
-    let slid = slope_slide(critical + 0.5, 2.0);
+    let held = slope_slide(&p, critical - 0.5, 2.0);
+    assert!(held < 0.5e-3, "{backend:?}: box crept {held} m at {:.3} deg", critical - 0.5);
+    let slid = slope_slide(&p, critical + 0.5, 2.0);
     // Analytic: a = g (sin - mu cos) = 0.096 m/s^2 -> 0.19 m in 2 s; demand at least half of it.
     let a = G * ((critical + 0.5).to_radians().sin() - 0.5 * (critical + 0.5).to_radians().cos());
-    assert!(slid > 0.5 * 0.5 * a * 4.0, "box slid only {slid} m at {:.3} deg", critical + 0.5);
+    assert!(slid > 0.5 * 0.5 * a * 4.0, "{backend:?}: box slid only {slid} m at {:.3} deg", critical + 0.5);
 }
 
 /// Whether two pads pressing `force` N each hold the box while the carriage accelerates up at `a`.
-fn pinch_holds(force: f64, mu: f64, a: f64) -> bool {
-    let p = PhysicsConfig::default();
-    let m = validation::pinch(&p, mu).unwrap();
-    let mut d = m.make_data();
-    let lift = m.name_to_id(mjOBJ_ACTUATOR, "lift").unwrap();
+fn pinch_holds(p: &PhysicsConfig, force: f64, mu: f64, a: f64) -> bool {
+    let mut run = ValidationRun::new(validation::pinch(p, mu).unwrap(), p).unwrap();
     // Carriage, pads and box [kg] (models/validation/pinch.xml).
     let (total, boxm) = (100.0 + 0.1 + 0.35, 0.35);
     for name in ["squeeze_l", "squeeze_r"] {
-        d.ctrl_mut()[m.name_to_id(mjOBJ_ACTUATOR, name).unwrap()] = force;
+        run.set_ctrl(name, force).unwrap();
     }
-    d.forward();
-    let (b, c) = (body(&m, "box"), body(&m, "carriage"));
-    let (settle, accelerate) = (0.2, 0.5);
-    let settle_steps = (settle / p.timestep_s) as usize;
-    d.ctrl_mut()[lift] = boxm * G;
-    for _ in 0..settle_steps {
-        d.step();
-    }
+    run.set_ctrl("lift", boxm * G).unwrap();
+    run.run_for(0.2).unwrap();
+    let rel = |run: &ValidationRun| run.body_position("box").unwrap()[2] - run.body_position("carriage").unwrap()[2];
     // Slip is counted from the start of the acceleration (the settling grip may sink a little).
-    let rel0 = d.xpos()[b][2] - d.xpos()[c][2];
-    d.ctrl_mut()[lift] = boxm * G + total * a;
-    for _ in 0..(accelerate / p.timestep_s) as usize {
-        d.step();
-    }
-    let slip = rel0 - (d.xpos()[b][2] - d.xpos()[c][2]);
-    slip < 1e-3
+    let rel0 = rel(&run);
+    run.set_ctrl("lift", boxm * G + total * a).unwrap();
+    run.run_for(0.5).unwrap();
+    rel0 - rel(&run) < 1e-3
 }
 
-#[test]
-fn pinch_holding_force_matches_analytic_bound() {
+/// Tolerance on the smallest holding force. MuJoCo: 5 % (measured +0.02 %, noslip iterations). rapier:
+/// 5 % too (modeling.md measured about 4 % off at 5 ms; its contacts are solved by impulses per step).
+fn pinch_holding_force_matches_analytic_bound(backend: Backend) {
+    let p = physics(backend);
     let (mass, mu, a) = (0.35, 0.8, 2.0);
     let analytic = mass * (G + a) / (2.0 * mu);
     let (mut lo, mut hi) = (0.5 * analytic, 2.0 * analytic);
-    assert!(!pinch_holds(lo, mu, a) && pinch_holds(hi, mu, a), "bracket fails");
+    assert!(!pinch_holds(&p, lo, mu, a) && pinch_holds(&p, hi, mu, a), "{backend:?}: bracket fails");
     for _ in 0..10 {
         let mid = 0.5 * (lo + hi);
-        if pinch_holds(mid, mu, a) { hi = mid } else { lo = mid }
+        if pinch_holds(&p, mid, mu, a) { hi = mid } else { lo = mid }
     }
     let found = 0.5 * (lo + hi);
     let err = (found - analytic) / analytic;
-    eprintln!("pinch: smallest holding force {found:.4} N, analytic {analytic:.4} N ({:+.3} %)", err * 100.0);
-    assert!(err.abs() < 0.05, "smallest holding force {found:.4} N vs analytic {analytic:.4} N ({:.2} %)", err * 100.0);
+    eprintln!(
+        "{backend:?} pinch: smallest holding force {found:.4} N, analytic {analytic:.4} N ({:+.3} %)",
+        err * 100.0
+    );
+    assert!(
+        err.abs() < 0.05,
+        "{backend:?}: smallest holding force {found:.4} N vs analytic {analytic:.4} N ({:.2} %)",
+        err * 100.0
+    );
 }
 
 /// Tendon winding speed of the test grasps [m/s]: a slow, steady wrap (a quarter of the motor's top
@@ -113,8 +127,8 @@ const WIND_M_S: f64 = 0.0075;
 
 /// Builds the scene, grows the finger (3.5 s at the motor's speed), winds `twine` m of tendon at
 /// [`WIND_M_S`], then holds `hold` s.
-fn grasp(spec: &SceneSpec, twine: f64, hold: f64) -> Result<Scene, PhysicsError> {
-    let mut s = Scene::build(spec)?;
+fn grasp(spec: &SceneSpec, twine: f64, hold: f64) -> Result<Box<dyn Physics>, PhysicsError> {
+    let mut s = SceneModel::build(spec)?.start()?;
     s.set_growth(spec.finger.length_m)?;
     s.run_for(3.5)?;
     let steps = (twine / WIND_M_S / s.timestep()).round().max(1.0) as usize;
@@ -126,9 +140,18 @@ fn grasp(spec: &SceneSpec, twine: f64, hold: f64) -> Result<Scene, PhysicsError>
     Ok(s)
 }
 
+/// MuJoCo only: its `touch` sensor is the independent check (rapier has no sensors; its pad force is
+/// the same sum of contact impulses the other checks read).
 #[test]
 fn pad_force_equals_mujoco_contact_force_on_the_pad() {
-    let s = grasp(&SceneSpec::default(), 0.03, 0.2).unwrap();
+    let mut s = Scene::build(&SceneSpec::default()).unwrap();
+    s.set_growth(0.14).unwrap();
+    s.run_for(3.5).unwrap();
+    for k in 1..=800 {
+        s.set_twine(0.03 * f64::from(k) / 800.0).unwrap();
+        s.step().unwrap();
+    }
+    s.run_for(0.2).unwrap();
     let r = s.readout();
     assert!(r.pad_force_n > 0.1, "pad not loaded: {r:?}");
     let touch = s.pad_touch_sensor_n();
@@ -136,14 +159,13 @@ fn pad_force_equals_mujoco_contact_force_on_the_pad() {
     assert!(r.grip_force_n >= r.pad_force_n && r.touching);
 }
 
-#[test]
-fn more_twine_gives_more_grip_and_pad_force() {
+fn more_twine_gives_more_grip_and_pad_force(backend: Backend) {
     // Grown (3.5 s at the motor's speed), then the tendon wound steadily from 0 to 45 mm: from 27 mm on
     // (the wrap has formed) the pad force and the hand's total normal force on the object (strip and
     // palm) rise at every 0.3 s sample, for every object.
     for name in [ObjectName::Crimper, ObjectName::Hammer, ObjectName::Shampoo] {
-        let spec = SceneSpec { object: Some(ObjectConfig { name, ..ObjectConfig::default() }), ..SceneSpec::default() };
-        let mut s = Scene::build(&spec).unwrap();
+        let spec = SceneSpec { object: Some(ObjectConfig { name, ..ObjectConfig::default() }), ..spec(backend) };
+        let mut s = SceneModel::build(&spec).unwrap().start().unwrap();
         s.set_growth(spec.finger.length_m).unwrap();
         s.run_for(3.5).unwrap();
         let n = (0.045 / WIND_M_S / s.timestep()).round() as usize;
@@ -166,7 +188,7 @@ fn more_twine_gives_more_grip_and_pad_force() {
             if let Some(l) = &last {
                 assert!(
                     r.pad_force_n > l.pad_force_n && r.grip_force_n + r.palm_force_n > l.grip_force_n + l.palm_force_n,
-                    "{name:?} at twine {:.4}: pad {:.3} -> {:.3} N, total {:.3} -> {:.3} N",
+                    "{backend:?} {name:?} at twine {:.4}: pad {:.3} -> {:.3} N, total {:.3} -> {:.3} N",
                     r.twine_setpoint_m,
                     l.pad_force_n,
                     r.pad_force_n,
@@ -176,29 +198,27 @@ fn more_twine_gives_more_grip_and_pad_force() {
             }
             last = Some(r);
         }
-        eprintln!("{name:?} twine:pad/total N{curve}");
+        eprintln!("{backend:?} {name:?} twine:pad/total N{curve}");
     }
 }
 
-#[test]
-fn contact_force_relaxes_under_a_fixed_twine() {
-    let mut s = grasp(&SceneSpec::default(), 0.03, 0.5).unwrap();
+fn contact_force_relaxes_under_a_fixed_twine(backend: Backend) {
+    let mut s = grasp(&spec(backend), 0.03, 0.5).unwrap();
     let early = s.readout();
     s.run_for(4.0).unwrap();
     let late = s.readout();
     assert!(
         late.grip_force_n < 0.95 * early.grip_force_n,
-        "no creep: {} -> {} N",
+        "{backend:?}: no creep: {} -> {} N",
         early.grip_force_n,
         late.grip_force_n
     );
     assert!(late.creep_m > early.creep_m);
 }
 
-#[test]
-fn a_loose_grip_lets_the_object_slip_out() {
+fn a_loose_grip_lets_the_object_slip_out(backend: Backend) {
     // Lift the hand 10 cm in 1 s with a twine that barely touches: the object stays behind.
-    let mut s = grasp(&SceneSpec::default(), 0.015, 0.2).unwrap();
+    let mut s = grasp(&spec(backend), 0.015, 0.2).unwrap();
     let z0 = s.readout().object_in_hand_m[2];
     let start = tendril::cell::physics::ur5e::forward(&tendril::cell::physics::ur5e::HOME);
     let mut seed = tendril::cell::physics::ur5e::HOME;
@@ -211,7 +231,7 @@ fn a_loose_grip_lets_the_object_slip_out() {
     }
     s.run_for(0.5).unwrap();
     let slip = s.readout().object_in_hand_m[2] - z0;
-    assert!(slip > 0.02, "object slipped only {slip} m");
+    assert!(slip > 0.02, "{backend:?}: object slipped only {slip} m");
 }
 
 #[test]
@@ -239,24 +259,22 @@ fn objects_have_the_papers_masses() {
     }
 }
 
-#[test]
-fn same_inputs_give_bit_identical_trajectories() {
-    let a = grasp(&SceneSpec::default(), 0.03, 0.3).unwrap();
-    let b = grasp(&SceneSpec::default(), 0.03, 0.3).unwrap();
-    assert_eq!(a.data().qpos(), b.data().qpos());
-    assert_eq!(a.data().qvel(), b.data().qvel());
+/// Bit-identical readouts (every position, velocity and force the cell sees).
+fn same_inputs_give_identical_trajectories(backend: Backend) {
+    let a = grasp(&spec(backend), 0.03, 0.3).unwrap();
+    let b = grasp(&spec(backend), 0.03, 0.3).unwrap();
+    assert_eq!(format!("{:?}", a.readout()), format!("{:?}", b.readout()));
 }
 
-#[test]
-fn runs_sharing_one_model_across_threads_match_a_sequential_run() {
-    let shared = SceneModel::build(&SceneSpec::default()).unwrap();
+fn runs_sharing_one_model_across_threads_match_a_sequential_run(backend: Backend) {
+    let shared = SceneModel::build(&spec(backend)).unwrap();
     let run = |shared: std::sync::Arc<SceneModel>| {
-        let mut s = Scene::new(shared);
+        let mut s = shared.start().unwrap();
         s.set_growth(0.14).unwrap();
         s.run_for(3.5).unwrap();
         s.set_twine(0.01).unwrap();
         s.run_for(1.0).unwrap();
-        s.data().qpos().to_vec()
+        format!("{:?}", s.readout())
     };
     let sequential = run(shared.clone());
     let threads: Vec<_> = (0..2)
@@ -272,18 +290,24 @@ fn runs_sharing_one_model_across_threads_match_a_sequential_run() {
     }
 }
 
-#[test]
-fn an_unstable_setting_is_reported_with_its_time() {
-    // Euler at 20 ms with an undamped, very stiff motor servo: omega * dt = sqrt(kp / m) * dt = 45,
-    // far beyond the explicit stability limit of 2. The strip is flung through the guide.
-    let mut spec = SceneSpec::default();
-    spec.physics.integrator = Integrator::Euler;
+fn an_unstable_setting_is_reported_with_its_time(backend: Backend) {
+    let mut spec = spec(backend);
     spec.physics.timestep_s = 0.02;
-    spec.finger.motor_kp_n_m = 1e7;
-    spec.finger.motor_kv_n_s_m = 0.0;
+    match backend {
+        // Euler at 20 ms with an undamped, very stiff motor servo: omega * dt = sqrt(kp / m) * dt = 45,
+        // far beyond the explicit stability limit of 2. The strip is flung through the guide.
+        Backend::Mujoco => {
+            spec.physics.integrator = Integrator::Euler;
+            spec.finger.motor_kp_n_m = 1e7;
+            spec.finger.motor_kv_n_s_m = 0.0;
+        }
+        // rapier's servos are implicit springs; its tendons are explicit forces: a tendon 10^4
+        // times stiffer, at 20 ms, puts omega * dt of the curl mode far past 2.
+        Backend::Rapier => spec.finger.tendon_stiffness_n_m = 3e7,
+    }
     match grasp(&spec, 0.03, 5.0) {
         Err(PhysicsError::Diverged { time_s, cause }) => {
-            eprintln!("unstable setting reported: t = {time_s} s, {cause}");
+            eprintln!("{backend:?} unstable setting reported: t = {time_s} s, {cause}");
             assert!(time_s > 0.0 && time_s < 1.0, "time {time_s}");
             assert!(!format!("{cause}").is_empty());
         }
@@ -292,41 +316,57 @@ fn an_unstable_setting_is_reported_with_its_time() {
     }
 }
 
-#[test]
-fn bad_inputs_are_errors_not_nan() {
-    let mut s = Scene::build(&SceneSpec::default()).unwrap();
+fn bad_inputs_are_errors_not_nan(backend: Backend) {
+    let mut s = SceneModel::build(&spec(backend)).unwrap().start().unwrap();
     assert!(matches!(s.set_twine(f64::NAN), Err(PhysicsError::BadInput { .. })));
     assert!(matches!(s.set_arm_target([0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0]), Err(PhysicsError::BadInput { .. })));
-    let mut spec = SceneSpec::default();
+    let mut spec = spec(backend);
     spec.finger.segments = 1;
     assert!(matches!(SceneModel::build(&spec), Err(PhysicsError::Config { key, .. }) if key == "finger.segments"));
 }
 
+/// The dynamic arm (servos) is MuJoCo-only: rapier refuses it by key.
 #[test]
-fn arm_models_put_the_hand_where_dh_kinematics_says() {
-    use tendril::cell::physics::{ArmMode, ur5e};
-    let q = [-1.3, -1.9, 1.7, -1.4, -1.5, 0.4];
-    for mode in [ArmMode::Kinematic, ArmMode::Dynamic] {
-        let mut spec = SceneSpec { object: None, arm_q0: q, ..SceneSpec::default() };
-        spec.physics.arm_mode = mode;
-        let s = Scene::build(&spec).unwrap();
-        // At the start both modes are exactly at the pose (MJCF body chain vs DH product).
-        let fk = ur5e::forward(&q).translation.vector;
-        let hand = s.readout().hand_pos_m;
-        let err = ((hand[0] - fk.x).powi(2) + (hand[1] - fk.y).powi(2) + (hand[2] - fk.z).powi(2)).sqrt();
-        assert!(err < 1e-9, "{mode:?}: hand {hand:?} vs DH {fk}");
-    }
-    // Moving: the hand follows a new target within 2 mm once settled, in both modes.
-    let target = [-1.5, -1.7, 1.8, -1.7, -1.57, 0.0];
-    for mode in [ArmMode::Kinematic, ArmMode::Dynamic] {
-        let mut spec = SceneSpec { object: None, arm_q0: q, ..SceneSpec::default() };
-        spec.physics.arm_mode = mode;
-        let mut s = Scene::build(&spec).unwrap();
-        s.set_arm_target(target).unwrap();
-        s.run_for(2.0).unwrap();
-        let fk = ur5e::forward(&target).translation.vector;
-        let hand = s.readout().hand_pos_m;
-        let err = ((hand[0] - fk.x).powi(2) + (hand[1] - fk.y).powi(2) + (hand[2] - fk.z).powi(2)).sqrt();
-        assert!(err < 2e-3, "{mode:?}: hand {hand:?} vs DH {fk} ({err} m)");
-    }
+fn rapier_refuses_the_dynamic_arm_by_key() {
+    let mut spec = spec(Backend::Rapier);
+    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Dynamic;
+    assert!(matches!(SceneModel::build(&spec), Err(PhysicsError::Config { key, .. }) if key == "physics.arm_mode"));
+}
+
+/// Distance between the readout's hand position and DH forward kinematics of `q` [m].
+fn hand_error_m(s: &dyn Physics, q: &[f64; 6]) -> f64 {
+    let fk = tendril::cell::physics::ur5e::forward(q).translation.vector;
+    let hand = s.readout().hand_pos_m;
+    ((hand[0] - fk.x).powi(2) + (hand[1] - fk.y).powi(2) + (hand[2] - fk.z).powi(2)).sqrt()
+}
+
+const ARM_START: [f64; 6] = [-1.3, -1.9, 1.7, -1.4, -1.5, 0.4];
+const ARM_TARGET: [f64; 6] = [-1.5, -1.7, 1.8, -1.7, -1.57, 0.0];
+
+/// At the start the hand is at the pose (MJCF body chain vs DH product: 1e-9 m on MuJoCo, 1e-6 m on
+/// rapier, whose world is placed joint by joint from the same chain); moving, it follows a new target
+/// within 2 mm once settled.
+fn kinematic_arm_puts_the_hand_where_dh_kinematics_says(backend: Backend) {
+    let spec = SceneSpec { object: None, arm_q0: ARM_START, ..spec(backend) };
+    let mut s = SceneModel::build(&spec).unwrap().start().unwrap();
+    let at_start = if backend == Backend::Mujoco { 1e-9 } else { 1e-6 };
+    let err = hand_error_m(s.as_ref(), &ARM_START);
+    assert!(err < at_start, "{backend:?}: hand {err} m from DH at the start");
+    s.set_arm_target(ARM_TARGET).unwrap();
+    s.run_for(2.0).unwrap();
+    let err = hand_error_m(s.as_ref(), &ARM_TARGET);
+    assert!(err < 2e-3, "{backend:?}: hand {err} m from DH after the move");
+}
+
+/// The dynamic arm (MuJoCo only): UR5e servos hold the hand at the pose and follow a target.
+#[test]
+fn dynamic_arm_puts_the_hand_where_dh_kinematics_says() {
+    let mut spec = SceneSpec { object: None, arm_q0: ARM_START, ..SceneSpec::default() };
+    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Dynamic;
+    let mut s = Scene::build(&spec).unwrap();
+    assert!(hand_error_m(&s, &ARM_START) < 1e-9);
+    s.set_arm_target(ARM_TARGET).unwrap();
+    s.run_for(2.0).unwrap();
+    let err = hand_error_m(&s, &ARM_TARGET);
+    assert!(err < 2e-3, "dynamic arm: hand {err} m from DH after the move");
 }

@@ -1,11 +1,11 @@
-//! The simulated cell: the MuJoCo scene and the FBG forward model behind [`Cell`].
+//! The simulated cell: the physics (MuJoCo or rapier) and the FBG forward model behind [`Cell`].
 //!
 //! Per tick the control code reads motor angles and the latest interrogator sample and writes
 //! motor targets, exactly as on the real cell. In between, [`Cell::wait_until`] steps the physics
 //! and samples the sensor model at the interrogator's rate with the pad's true contact force.
 
 use super::fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
-use super::physics::{PhysicsError, PhysicsReadout, Scene, SceneModel};
+use super::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel};
 use crate::control::gripper::GripperConfig;
 use crate::hardware::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
 use crate::scenario::{Checker, Validate};
@@ -45,10 +45,10 @@ impl EnvironmentConfig {
     }
 }
 
-/// Twin of the gripping cell: MuJoCo physics + FBG forward model.
+/// Twin of the gripping cell: physics (the backend the scene's spec names) + FBG forward model.
 pub struct SimCell {
     model: Arc<SceneModel>,
-    scene: Option<Scene>,
+    scene: Option<Box<dyn Physics>>,
     sensor_config: SensorConfig,
     interrogator: InterrogatorConfig,
     sensor: FbgSensor,
@@ -102,8 +102,8 @@ impl SimCell {
         )
     }
 
-    fn scene(&self) -> &Scene {
-        self.scene.as_ref().expect("configured before use: the lifecycle checks guarantee it")
+    fn scene(&self) -> &dyn Physics {
+        self.scene.as_deref().expect("configured before use: the lifecycle checks guarantee it")
     }
 
     fn physics_error(e: PhysicsError) -> CellError {
@@ -130,7 +130,7 @@ impl SimCell {
 
 impl Cell for SimCell {
     fn backend(&self) -> &str {
-        "mujoco"
+        self.model.spec().physics.backend.name()
     }
 
     fn lifecycle(&self) -> Lifecycle {
@@ -139,7 +139,7 @@ impl Cell for SimCell {
 
     fn configure(&mut self) -> Result<(), CellError> {
         require_state(self.lifecycle, Lifecycle::Unconfigured, "configure")?;
-        self.scene = Some(Scene::new(self.model.clone()));
+        self.scene = Some(self.model.start().map_err(Self::physics_error)?);
         self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
         self.next_sample_s = 0.0;
         self.lifecycle = Lifecycle::Inactive;

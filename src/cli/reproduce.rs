@@ -2,6 +2,7 @@
 
 use super::{emit, exit_all, write_file};
 use crate::reproduce::{Row, render_table};
+use crate::scenario::Override;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -16,10 +17,14 @@ pub struct ReproduceArgs {
     /// Folder holding the scenario files.
     #[arg(long, default_value = "scenarios")]
     scenarios: PathBuf,
+    /// The twin's physics engine for Sec. V, `mujoco` or `rapier` (default: the scenarios' own).
+    #[arg(long)]
+    backend: Option<crate::cell::physics::Backend>,
 }
 
 pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
-    let rows = reproduce_rows(&a.what, &a.scenarios)?;
+    let overrides: Vec<Override> = a.backend.map(Override::backend).into_iter().collect();
+    let rows = reproduce_rows(&a.what, &a.scenarios, &overrides)?;
     emit(&render_table(&rows));
     if let Some(path) = a.json {
         write_file(&path, &(serde_json::to_string_pretty(&rows)? + "\n"))?;
@@ -27,14 +32,15 @@ pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
     Ok(exit_all(rows.iter().all(|r| r.pass)))
 }
 
-/// The rows of `tendril reproduce WHAT`: `sensor` (Sec. IV), `gripper` (Sec. V) or `all`.
-pub fn reproduce_rows(what: &str, scenario_dir: &Path) -> anyhow::Result<Vec<Row>> {
+/// The rows of `tendril reproduce WHAT`: `sensor` (Sec. IV), `gripper` (Sec. V, with `overrides`
+/// on its scenarios) or `all`.
+pub fn reproduce_rows(what: &str, scenario_dir: &Path, overrides: &[Override]) -> anyhow::Result<Vec<Row>> {
     match what {
         "sensor" => crate::reproduce::sensor::rows(scenario_dir),
-        "gripper" => crate::reproduce::gripper::rows(scenario_dir, &[]),
+        "gripper" => crate::reproduce::gripper::rows(scenario_dir, overrides),
         "all" => {
             let mut rows = crate::reproduce::sensor::rows(scenario_dir)?;
-            rows.extend(crate::reproduce::gripper::rows(scenario_dir, &[])?);
+            rows.extend(crate::reproduce::gripper::rows(scenario_dir, overrides)?);
             Ok(rows)
         }
         other => anyhow::bail!("reproduce {other}: unknown (expected sensor, gripper or all)"),

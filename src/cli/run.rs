@@ -25,6 +25,9 @@ pub struct RunArgs {
     /// Override a scenario value: `--set key.path=value` (repeatable), checked like the file.
     #[arg(long = "set")]
     set: Vec<Override>,
+    /// The twin's physics engine, `mujoco` or `rapier` (the scenario's `physics.backend`).
+    #[arg(long)]
+    backend: Option<crate::cell::physics::Backend>,
     /// Which cell runs the task: the twin (`sim`) or the devices (`real`).
     #[arg(long, value_parser = ["sim", "real"], default_value = "sim")]
     hardware: String,
@@ -42,6 +45,7 @@ impl RunArgs {
         if let Some(f) = &self.feedback {
             o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
         }
+        o.extend(self.backend.map(Override::backend));
         o
     }
 }

@@ -13,6 +13,13 @@ pub struct Override {
     pub value: toml::Value,
 }
 
+impl Override {
+    /// `physics.backend = NAME`: what `--backend` means on the command line.
+    pub fn backend(backend: crate::cell::physics::Backend) -> Override {
+        Override { key: "physics.backend".into(), value: toml::Value::String(backend.name().into()) }
+    }
+}
+
 impl std::str::FromStr for Override {
     type Err = ScenarioError;
 

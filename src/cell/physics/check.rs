@@ -1,7 +1,7 @@
 //! `tendril physics-check`: builds a scene from a scenario and runs a scripted grasp, printing the
 //! readout, to help tune the finger.
 
-use super::{FingerConfig, ObjectConfig, PhysicsConfig, PhysicsError, Scene, SceneSpec, ur5e};
+use super::{FingerConfig, ObjectConfig, PhysicsConfig, PhysicsError, SceneModel, SceneSpec, ur5e};
 use crate::scenario::{Checker, Validate};
 use serde::Deserialize;
 
@@ -93,7 +93,7 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
         object: Some(s.object.clone()),
         arm_q0: ur5e::HOME,
     };
-    let mut scene = Scene::build(&spec)?;
+    let mut scene = SceneModel::build(&spec)?.start()?;
     let c = &s.check;
     // Growth runs at the motor's speed; the twine ramp starts 0.5 s after it is done.
     let t_twine = c.growth_m / s.finger.motor_max_speed_m_s + 0.5;

@@ -1,4 +1,5 @@
-//! Scenario sections `[physics]`, `[finger]` and `[object]`: every tunable of the MuJoCo scene.
+//! Scenario sections `[physics]` (with `[physics.rapier]`), `[finger]` and `[object]`: every tunable of
+//! the scene and of the engines that simulate it.
 
 use crate::scenario::{Checker, Validate};
 use serde::Deserialize;
@@ -27,6 +28,111 @@ pub enum Cone {
     Elliptic,
 }
 
+/// Which engine simulates the scene (`physics.backend`). Both run the same scene, compiled once by
+/// MuJoCo from models/ (see [`super::rapier`] for how the rapier world is built from it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// MuJoCo 3.17 (soft contacts, elliptic cones, implicit integrators): the reference.
+    #[default]
+    Mujoco,
+    /// rapier3d 0.36 (f64): reduced-coordinate multibody finger, impulse-based contacts.
+    Rapier,
+}
+
+impl Backend {
+    /// The name as written in scenarios and summaries (`mujoco`, `rapier`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Mujoco => "mujoco",
+            Backend::Rapier => "rapier",
+        }
+    }
+}
+
+impl std::str::FromStr for Backend {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Backend, String> {
+        match s {
+            "mujoco" => Ok(Backend::Mujoco),
+            "rapier" => Ok(Backend::Rapier),
+            other => Err(format!("unknown physics backend `{other}` (expected mujoco or rapier)")),
+        }
+    }
+}
+
+/// rapier's friction constraints for contacts between two rigid bodies (contacts with the finger,
+/// a multibody, always use the Coulomb model in rapier 0.36).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RapierFriction {
+    /// One friction constraint per group of contacts plus a twist constraint.
+    Simplified,
+    /// One Coulomb friction constraint per contact point.
+    Coulomb,
+}
+
+/// `[physics.rapier]`: the rapier backend's own settings (the MuJoCo options of `[physics]`,
+/// integrator, cone, impratio, solver and noslip iterations, solref/solimp, do not apply to it;
+/// `timestep_s`, `arm_mode`, `arm_max_speed_rad_s` and the divergence bounds do).
+///
+/// Defaults chosen with tests/physics_validation.rs, which runs the analytic cases on both backends,
+/// and the facts measured for rapier 0.36 in ../shared/reference/modeling.md.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RapierConfig {
+    /// Solver iterations per step. 8: modeling.md saw a 12-link chain track its spring targets to
+    /// 0.03 rad at 4 as a multibody; the finger's contacts with a 0.4 kg object want more.
+    pub solver_iterations: u32,
+    /// Internal PGS iterations per solver iteration.
+    pub pgs_iterations: u32,
+    /// Stabilisation (position-correction) iterations per solver iteration.
+    pub stabilization_iterations: u32,
+    /// Friction model between rigid bodies. `simplified`: modeling.md measured the slip angle within
+    /// 0.03 deg of atan(mu) with it, where the Coulomb model slips about 1.5 deg early.
+    pub friction_model: RapierFriction,
+    /// Natural frequency of the contact constraints' softness [Hz] (rapier's default 30).
+    pub contact_frequency_hz: f64,
+    /// Damping ratio of the contact constraints' softness (rapier's default).
+    pub contact_damping_ratio: f64,
+    /// Length scale of rapier's tolerances [m]: slop 0.005 x, speculative margin 0.02 x. rapier is
+    /// tuned for metre-sized bodies (slop 5 mm); the finger is 2 mm thick and grips 25 mm handles,
+    /// so 0.02: slop 0.1 mm, margin 0.4 mm.
+    pub length_unit_m: f64,
+}
+
+impl Default for RapierConfig {
+    fn default() -> Self {
+        RapierConfig {
+            solver_iterations: 8,
+            pgs_iterations: 1,
+            stabilization_iterations: 1,
+            friction_model: RapierFriction::Simplified,
+            contact_frequency_hz: 30.0,
+            contact_damping_ratio: 5.0,
+            length_unit_m: 0.02,
+        }
+    }
+}
+
+impl Validate for RapierConfig {
+    fn validate(&self, at: &mut Checker) {
+        at.require("solver_iterations", (1..=1000).contains(&self.solver_iterations), || {
+            format!("must be between 1 and 1000, got {}", self.solver_iterations)
+        });
+        at.require("pgs_iterations", (1..=100).contains(&self.pgs_iterations), || {
+            format!("must be between 1 and 100, got {}", self.pgs_iterations)
+        });
+        at.require("stabilization_iterations", self.stabilization_iterations <= 100, || {
+            format!("must be at most 100, got {}", self.stabilization_iterations)
+        });
+        at.in_range("contact_frequency_hz", self.contact_frequency_hz, 0.1, 10000.0);
+        at.positive("contact_damping_ratio", self.contact_damping_ratio);
+        at.in_range("length_unit_m", self.length_unit_m, 1e-4, 10.0);
+    }
+}
+
 /// How the UR5e is simulated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -50,6 +156,8 @@ pub enum ArmMode {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
+    /// The engine (`mujoco` | `rapier`); `--backend` on the command line sets it too.
+    pub backend: Backend,
     /// Simulation step [s]. 5 ms: the largest step at which the contact time constant (10 ms) is still
     /// two steps (MuJoCo's minimum) and the pinch bound holds to 0.02 %; 2 ms runs ~2.5x slower.
     pub timestep_s: f64,
@@ -94,11 +202,14 @@ pub struct PhysicsConfig {
     /// Divergence bound: largest allowed kinetic energy of the scene [J]. The cell's moving parts hold
     /// < 5 J at UR5e speeds (20 kg arm at 0.5 m/s); 200 J means runaway.
     pub max_kinetic_energy_j: f64,
+    /// The rapier backend's own settings (`[physics.rapier]`).
+    pub rapier: RapierConfig,
 }
 
 impl Default for PhysicsConfig {
     fn default() -> Self {
         PhysicsConfig {
+            backend: Backend::Mujoco,
             timestep_s: 0.005,
             integrator: Integrator::Implicitfast,
             cone: Cone::Elliptic,
@@ -115,6 +226,7 @@ impl Default for PhysicsConfig {
             arm_max_speed_rad_s: std::f64::consts::PI,
             max_penetration_m: 0.005,
             max_kinetic_energy_j: 200.0,
+            rapier: RapierConfig::default(),
         }
     }
 }
@@ -136,6 +248,12 @@ impl Validate for PhysicsConfig {
         at.positive("arm_max_speed_rad_s", self.arm_max_speed_rad_s);
         at.positive("max_penetration_m", self.max_penetration_m);
         at.positive("max_kinetic_energy_j", self.max_kinetic_energy_j);
+        at.section("rapier", &self.rapier);
+        at.require("arm_mode", !(self.backend == Backend::Rapier && self.arm_mode == ArmMode::Dynamic), || {
+            "the dynamic arm (UR5e servos) is MuJoCo-only; the rapier backend prescribes the arm's motion \
+             (arm_mode = \"kinematic\")"
+                .into()
+        });
     }
 }
 

@@ -1,23 +1,77 @@
-//! The MuJoCo physics of the cell: UR5e, grow-and-twine finger with the FBG sensor pad, one of the
-//! paper's objects and the table, assembled from models/ for what a scenario needs.
+//! The physics of the cell: UR5e, grow-and-twine finger with the FBG sensor pad, one of the paper's
+//! objects and the table, assembled from models/ for what a scenario needs and simulated by MuJoCo or
+//! rapier behind one [`Physics`] trait.
 //!
-//! - [`config`]: the `[physics]`, `[finger]` and `[object]` scenario sections.
-//! - [`compose`]: MJCF assembly from the model files.
-//! - [`scene`]: [`Scene`] (one simulation run: step, actuator inputs, [`PhysicsReadout`]) on a shared
-//!   [`SceneModel`].
+//! - [`config`]: the `[physics]` (with `[physics.rapier]`), `[finger]` and `[object]` sections.
+//! - [`compose`]: MJCF assembly from the model files. MuJoCo compiles it into the [`SceneModel`],
+//!   the one description of the scene both backends start from.
+//! - [`scene`]: the MuJoCo run ([`Scene`]); [`rapier`]: the rapier world built from the compiled
+//!   model and its run ([`rapier::RapierScene`]).
+//! - [`drive`]: motor speed limits, the kinematic arm's interpolation and the grip-in-hand
+//!   readout, shared by both backends.
 //! - [`ur5e`]: DH kinematics.
 
 pub mod check;
 pub mod compose;
 pub mod config;
+pub mod drive;
+pub mod rapier;
 pub mod scene;
 pub mod template;
 pub mod ur5e;
 pub mod validation;
 
 pub use compose::Placement;
-pub use config::{ArmMode, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig};
+pub use config::{
+    ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig,
+};
 pub use scene::{PhysicsReadout, Scene, SceneModel};
+
+/// One simulation run of the cell, whichever engine steps it. The cell ([`crate::cell::sim`]) only
+/// talks to this.
+pub trait Physics: Send {
+    /// The engine.
+    fn backend(&self) -> Backend;
+    /// Simulated time [s].
+    fn time(&self) -> f64;
+    /// Step size [s].
+    fn timestep(&self) -> f64;
+    /// Commands the finger growth (strip length out of the guide) [m], clamped to 0..finger.length_m.
+    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
+    fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError>;
+    /// Commands the twine motor: metres of tendon wound in (the twining/curl input, the PID's output),
+    /// clamped to 0..finger.twine_max_m. More twine curls the strip tighter and raises the grip force.
+    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
+    fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError>;
+    /// Commands the arm joint targets [rad]. Dynamic mode: the position servos' setpoints. Kinematic
+    /// mode: the arm moves towards them at most at `physics.arm_max_speed_rad_s` per joint, and the hand
+    /// follows the flange pose from forward kinematics.
+    fn set_arm_target(&mut self, q: [f64; 6]) -> Result<(), PhysicsError>;
+    /// Advances one step; a diverging state is a [`PhysicsError::Diverged`] with the time.
+    fn step(&mut self) -> Result<(), PhysicsError>;
+    /// The readout after the last step.
+    fn readout(&self) -> PhysicsReadout;
+
+    /// Steps for `seconds` of simulated time (rounded to whole steps).
+    fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
+        let n = (seconds / self.timestep()).round() as usize;
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+}
+
+impl SceneModel {
+    /// A fresh run on this model with the engine its spec names (`physics.backend`), at the start
+    /// placement with the finger retracted and slack.
+    pub fn start(self: &std::sync::Arc<Self>) -> Result<Box<dyn Physics>, PhysicsError> {
+        Ok(match self.spec().physics.backend {
+            Backend::Mujoco => Box::new(Scene::new(self.clone())),
+            Backend::Rapier => Box::new(rapier::RapierScene::new(self.clone())?),
+        })
+    }
+}
 
 use crate::scenario::{Checker, Validate};
 
@@ -97,6 +151,15 @@ pub enum PhysicsError {
         kind: &'static str,
         /// Its name.
         name: String,
+    },
+    /// The scene holds an element the backend cannot simulate (a model the rapier translation does
+    /// not cover).
+    #[error("the {backend} backend cannot simulate {what}")]
+    Unsupported {
+        /// The backend.
+        backend: &'static str,
+        /// The element and why.
+        what: String,
     },
     /// The simulation diverged.
     #[error("simulation diverged at t = {time_s:.4} s: {cause}")]

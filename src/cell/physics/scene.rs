@@ -1,12 +1,13 @@
 //! One simulation run of the cell: a compiled, shareable [`SceneModel`] and per-run [`Scene`] state.
 
 use super::compose::{self, Placement};
-use super::config::ArmMode;
-use super::{Divergence, PhysicsError, SceneSpec};
+use super::config::{ArmMode, Backend};
+use super::drive::{Drive, grip_in_hand};
+use super::{Divergence, Physics, PhysicsError, SceneSpec};
 use crate::scenario::{Checker, Validate};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtWarning};
 use mujoco_rs::prelude::{MjData, MjModel};
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Vector3};
 use std::sync::Arc;
 
 /// A compiled scene model and the element ids the readout needs. Build it once and share it (it is
@@ -20,32 +21,39 @@ pub struct SceneModel {
     ids: Ids,
 }
 
+/// Ids of the elements the readout and the backends need (MuJoCo's numbering, which the rapier
+/// world keeps: it is built from the same compiled model).
 #[derive(Debug, Clone)]
-struct Ids {
+pub(crate) struct Ids {
     /// Geoms of the sensor pad (casing, bump).
-    pad_geoms: Vec<usize>,
+    pub(crate) pad_geoms: Vec<usize>,
     /// Geoms of the strip and the pad.
-    finger_geoms: Vec<usize>,
+    pub(crate) finger_geoms: Vec<usize>,
     /// The palm beside the guide exit.
-    palm_geom: Vec<usize>,
+    pub(crate) palm_geom: Vec<usize>,
     /// The object's geoms (empty without object).
-    object_geoms: Vec<usize>,
-    object_body: Option<usize>,
-    object_grip: Option<usize>,
-    object_qpos: Option<usize>,
-    hand_body: usize,
-    growth_qpos: usize,
-    twine_qpos: usize,
-    creep_qpos: usize,
-    growth_act: usize,
-    twine_act: usize,
-    arm_qpos: [usize; 6],
-    arm_dof: [usize; 6],
+    pub(crate) object_geoms: Vec<usize>,
+    pub(crate) object_body: Option<usize>,
+    pub(crate) object_grip: Option<usize>,
+    pub(crate) object_qpos: Option<usize>,
+    pub(crate) hand_body: usize,
+    pub(crate) growth_qpos: usize,
+    pub(crate) twine_qpos: usize,
+    pub(crate) creep_qpos: usize,
+    pub(crate) growth_act: usize,
+    /// Joints of the growth and twine outputs, the creep node and the arm.
+    pub(crate) growth_joint: usize,
+    pub(crate) twine_joint: usize,
+    pub(crate) creep_joint: usize,
+    pub(crate) arm_joint: [usize; 6],
+    pub(crate) twine_act: usize,
+    pub(crate) arm_qpos: [usize; 6],
+    pub(crate) arm_dof: [usize; 6],
     /// Servo actuators of the arm (dynamic mode only).
-    arm_act: Option<[usize; 6]>,
-    tendon_elastic: usize,
-    tendon_maxwell: usize,
-    pad_touch_adr: usize,
+    pub(crate) arm_act: Option<[usize; 6]>,
+    pub(crate) tendon_elastic: usize,
+    pub(crate) tendon_maxwell: usize,
+    pub(crate) pad_touch_adr: usize,
 }
 
 fn id(model: &MjModel, kind: _mjtObjBase, kind_name: &'static str, name: &str) -> Result<usize, PhysicsError> {
@@ -106,9 +114,11 @@ impl SceneModel {
         let names = ["shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"];
         let mut arm_qpos = [0; 6];
         let mut arm_dof = [0; 6];
+        let mut arm_joint = [0; 6];
         for k in 0..6 {
+            arm_joint[k] = joint(names[k])?;
             arm_qpos[k] = qpos(names[k])?;
-            arm_dof[k] = m.jnt_dofadr()[joint(names[k])?] as usize;
+            arm_dof[k] = m.jnt_dofadr()[arm_joint[k]] as usize;
         }
         let arm_act = match spec.physics.arm_mode {
             ArmMode::Kinematic => None,
@@ -134,6 +144,10 @@ impl SceneModel {
             twine_qpos: qpos("twine")?,
             creep_qpos: qpos("creep")?,
             growth_act: act("growth")?,
+            growth_joint: joint("growth")?,
+            twine_joint: joint("twine")?,
+            creep_joint: joint("creep")?,
+            arm_joint,
             twine_act: act("twine")?,
             arm_qpos,
             arm_dof,
@@ -157,6 +171,11 @@ impl SceneModel {
     /// Where the parts start (hand pose, object footprint, table height).
     pub fn placement(&self) -> &Placement {
         &self.placement
+    }
+
+    /// Element ids for the backends.
+    pub(crate) fn ids(&self) -> &Ids {
+        &self.ids
     }
 
     /// The assembled MJCF text (for inspection or saving).
@@ -208,20 +227,13 @@ pub struct PhysicsReadout {
     pub arm_q: [f64; 6],
 }
 
-/// One simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a bit-identical
-/// trajectory.
+/// One MuJoCo simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a
+/// bit-identical trajectory.
 #[derive(Debug)]
 pub struct Scene {
     shared: Arc<SceneModel>,
     data: MjData<Arc<MjModel>>,
-    arm_target: [f64; 6],
-    arm_q: [f64; 6],
-    /// Kinematic mode: simulated time of the latest arm command and the interval since the one before
-    /// [s]; the move to a new target is spread over that interval (see [`Scene::step`]).
-    arm_command_s: Option<f64>,
-    arm_command_period_s: f64,
-    /// Commanded growth and twine [m]; the servo setpoints move towards them at the motor speed.
-    motor_target: [f64; 2],
+    drive: Drive,
     warnings_seen: [i32; 8],
 }
 
@@ -260,16 +272,8 @@ impl Scene {
             }
         }
         data.forward();
-        Scene {
-            shared,
-            data,
-            arm_target: q0,
-            arm_q: q0,
-            arm_command_s: None,
-            arm_command_period_s: 0.0,
-            motor_target: [0.0; 2],
-            warnings_seen: [0; 8],
-        }
+        let drive = Drive::new(&shared.spec.physics, &shared.spec.finger, q0);
+        Scene { shared, data, drive, warnings_seen: [0; 8] }
     }
 
     /// The shared model.
@@ -282,95 +286,24 @@ impl Scene {
         &self.data
     }
 
-    /// Simulated time [s].
-    pub fn time(&self) -> f64 {
-        self.data.time()
-    }
-
-    /// Step size [s].
-    pub fn timestep(&self) -> f64 {
-        self.shared.spec.physics.timestep_s
-    }
-
-    /// Commands the finger growth (strip length out of the guide) [m], clamped to 0..finger.length_m.
-    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
-    pub fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
-        if !growth_m.is_finite() {
-            return Err(PhysicsError::BadInput { what: "growth", value: growth_m });
-        }
-        self.motor_target[0] = growth_m.clamp(0.0, self.shared.spec.finger.length_m);
-        Ok(())
-    }
-
-    /// Commands the twine motor: metres of tendon wound in (the twining/curl input, the PID's output),
-    /// clamped to 0..finger.twine_max_m. More twine curls the strip tighter and raises the grip force.
-    /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
-    pub fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError> {
-        if !twine_m.is_finite() {
-            return Err(PhysicsError::BadInput { what: "twine", value: twine_m });
-        }
-        self.motor_target[1] = twine_m.clamp(0.0, self.shared.spec.finger.twine_max_m);
-        Ok(())
-    }
-
-    /// Commands the arm joint targets [rad]. Dynamic mode: the position servos' setpoints. Kinematic
-    /// mode: the arm moves towards them at most at `physics.arm_max_speed_rad_s` per joint, and the hand
-    /// follows the flange pose from forward kinematics.
-    pub fn set_arm_target(&mut self, q: [f64; 6]) -> Result<(), PhysicsError> {
-        if let Some(v) = q.iter().find(|v| !v.is_finite()) {
-            return Err(PhysicsError::BadInput { what: "arm target", value: *v });
-        }
-        self.arm_target = q;
-        let now = self.data.time();
-        self.arm_command_period_s = self.arm_command_s.map_or(0.0, |t| now - t);
-        self.arm_command_s = Some(now);
-        if let Some(acts) = self.shared.ids.arm_act {
-            for (k, a) in acts.iter().enumerate() {
-                self.data.ctrl_mut()[*a] = q[k];
-            }
-        }
-        Ok(())
-    }
-
     /// Advances one step; a diverging state is a [`PhysicsError::Diverged`] with the time.
-    pub fn step(&mut self) -> Result<(), PhysicsError> {
+    fn step_once(&mut self) -> Result<(), PhysicsError> {
         let t0 = self.data.time();
-        let max = self.shared.spec.finger.motor_max_speed_m_s * self.timestep();
+        let dt = self.shared.spec.physics.timestep_s;
+        let set = self.drive.advance(t0, dt);
         let ids = &self.shared.ids;
-        for (act, target) in [(ids.growth_act, self.motor_target[0]), (ids.twine_act, self.motor_target[1])] {
-            let ctrl = &mut self.data.ctrl_mut()[act];
-            *ctrl += (target - *ctrl).clamp(-max, max);
-        }
-        if self.shared.ids.arm_act.is_none() {
+        self.data.ctrl_mut()[ids.growth_act] = set.motors[0];
+        self.data.ctrl_mut()[ids.twine_act] = set.motors[1];
+        if ids.arm_act.is_none() {
             // Prescribed motion: the joint velocity that takes the actual angles to the next commanded
             // ones in this step (so nothing drifts). Writing qpos directly instead doubled the step time.
-            // A controller commands a new target every control tick (several steps): the remaining
-            // way is spread evenly over the steps left until the next command is due, so the hand
-            // moves at the commanded velocity. Jumping to each target in one step and then standing
-            // still shook the hand at the control rate (at 100 Hz during the transfer, ±0.15 m/s
-            // every 5 ms, tens of m/s²) and knocked held objects out of the grip. A target set
-            // once, or every step, is still approached at the speed limit as before.
-            let dt = self.timestep();
-            let max = self.shared.spec.physics.arm_max_speed_rad_s * dt;
-            let due = self.arm_command_s.map_or(t0, |t| t + self.arm_command_period_s);
-            let share = (dt / (due - t0).max(dt)).min(1.0);
             for k in 0..6 {
-                self.arm_q[k] += ((self.arm_target[k] - self.arm_q[k]) * share).clamp(-max, max);
                 let actual = self.data.qpos()[ids.arm_qpos[k]];
-                self.data.qvel_mut()[ids.arm_dof[k]] = (self.arm_q[k] - actual) / dt;
+                self.data.qvel_mut()[ids.arm_dof[k]] = (set.arm_q[k] - actual) / dt;
             }
         }
         self.data.step();
-        self.check(t0 + self.timestep())
-    }
-
-    /// Steps for `seconds` of simulated time (rounded to whole steps).
-    pub fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
-        let n = (seconds / self.timestep()).round() as usize;
-        for _ in 0..n {
-            self.step()?;
-        }
-        Ok(())
+        self.check(t0 + dt)
     }
 
     fn check(&mut self, time_s: f64) -> Result<(), PhysicsError> {
@@ -435,8 +368,7 @@ impl Scene {
         self.data.sensordata()[self.shared.ids.pad_touch_adr]
     }
 
-    /// The readout after the last step.
-    pub fn readout(&self) -> PhysicsReadout {
+    fn mujoco_readout(&self) -> PhysicsReadout {
         let ids = &self.shared.ids;
         let qpos = self.data.qpos();
         let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
@@ -456,12 +388,12 @@ impl Scene {
             hand_pos_m: hand_p.into(),
             growth_m: qpos[ids.growth_qpos],
             twine_m: qpos[ids.twine_qpos],
-            twine_setpoint_m: self.data.ctrl()[ids.twine_act],
+            twine_setpoint_m: self.drive.twine_setpoint_m(),
             creep_m: qpos[ids.creep_qpos],
             tendon_tension_n: self.tendon_tension_n(),
             arm_q: match ids.arm_act {
                 Some(_) => ids.arm_qpos.map(|a| qpos[a]),
-                None => self.arm_q,
+                None => self.drive.arm_q(),
             },
             ..PhysicsReadout::default()
         };
@@ -473,10 +405,10 @@ impl Scene {
             let vh = self.data.object_velocity(_mjtObjBase::mjOBJ_BODY, ids.hand_body, false);
             let v_obj = Vector3::new(vo[3], vo[4], vo[5]);
             let w_hand = Vector3::new(vh[0], vh[1], vh[2]);
-            let v_hand_at = Vector3::new(vh[3], vh[4], vh[5]) + w_hand.cross(&(p - hand_p));
+            let in_hand = grip_in_hand(&hand, Vector3::new(vh[3], vh[4], vh[5]), w_hand, p, v_obj);
             r.object_vel_m_s = v_obj.into();
-            r.slip_speed_m_s = (v_obj - v_hand_at).norm();
-            r.object_in_hand_m = (hand.inverse() * Point3::from(p)).coords.into();
+            r.slip_speed_m_s = in_hand.slip_speed_m_s;
+            r.object_in_hand_m = in_hand.position_m;
         }
         r
     }
@@ -500,6 +432,46 @@ impl Scene {
     /// Geom ids of the object.
     pub fn object_geoms(&self) -> &[usize] {
         &self.shared.ids.object_geoms
+    }
+}
+
+impl Physics for Scene {
+    fn backend(&self) -> Backend {
+        Backend::Mujoco
+    }
+
+    fn time(&self) -> f64 {
+        self.data.time()
+    }
+
+    fn timestep(&self) -> f64 {
+        self.shared.spec.physics.timestep_s
+    }
+
+    fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
+        self.drive.set_growth(growth_m)
+    }
+
+    fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError> {
+        self.drive.set_twine(twine_m)
+    }
+
+    fn set_arm_target(&mut self, q: [f64; 6]) -> Result<(), PhysicsError> {
+        self.drive.set_arm_target(q, self.data.time())?;
+        if let Some(acts) = self.shared.ids.arm_act {
+            for (k, a) in acts.iter().enumerate() {
+                self.data.ctrl_mut()[*a] = q[k];
+            }
+        }
+        Ok(())
+    }
+
+    fn step(&mut self) -> Result<(), PhysicsError> {
+        self.step_once()
+    }
+
+    fn readout(&self) -> PhysicsReadout {
+        self.mujoco_readout()
     }
 }
 

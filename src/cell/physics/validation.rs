@@ -33,3 +33,84 @@ pub fn slope(p: &PhysicsConfig, angle_rad: f64) -> Result<MjModel, PhysicsError>
 pub fn pinch(p: &PhysicsConfig, mu: f64) -> Result<MjModel, PhysicsError> {
     compile(PINCH, &[("header", header(p)), ("mu", num(mu))])
 }
+
+/// One of these scenes run on either backend (`physics.backend`), with what the analytic checks
+/// read: body positions and contact normal forces, by MuJoCo name.
+pub struct ValidationRun {
+    model: std::sync::Arc<MjModel>,
+    engine: Engine,
+}
+
+enum Engine {
+    Mujoco(Box<mujoco_rs::prelude::MjData<std::sync::Arc<MjModel>>>),
+    Rapier(Box<super::rapier::RapierWorld>),
+}
+
+impl ValidationRun {
+    /// Starts `model` at its `qpos0` on the backend `p` names.
+    pub fn new(model: MjModel, p: &PhysicsConfig) -> Result<ValidationRun, PhysicsError> {
+        let model = std::sync::Arc::new(model);
+        let engine = match p.backend {
+            super::Backend::Mujoco => {
+                let mut d = mujoco_rs::prelude::MjData::new(model.clone());
+                d.forward();
+                Engine::Mujoco(Box::new(d))
+            }
+            super::Backend::Rapier => Engine::Rapier(Box::new(super::rapier::RapierWorld::build(&model, p, &[])?)),
+        };
+        Ok(ValidationRun { model, engine })
+    }
+
+    fn id(&self, kind: mujoco_rs::mujoco_c::_mjtObjBase, name: &str) -> Result<usize, PhysicsError> {
+        self.model.name_to_id(kind, name).ok_or_else(|| PhysicsError::Missing { kind: "element", name: name.into() })
+    }
+
+    /// Sets the named actuator's control.
+    pub fn set_ctrl(&mut self, actuator: &str, value: f64) -> Result<(), PhysicsError> {
+        let a = self.id(mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_ACTUATOR, actuator)?;
+        match &mut self.engine {
+            Engine::Mujoco(d) => d.ctrl_mut()[a] = value,
+            Engine::Rapier(w) => w.set_ctrl(a, value),
+        }
+        Ok(())
+    }
+
+    /// Steps for `seconds` (whole steps).
+    pub fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
+        let dt = self.model.opt().timestep;
+        for _ in 0..(seconds / dt).round() as usize {
+            match &mut self.engine {
+                Engine::Mujoco(d) => d.step(),
+                Engine::Rapier(w) => w.step()?,
+            }
+        }
+        Ok(())
+    }
+
+    /// World position of the named body's origin [m].
+    pub fn body_position(&self, body: &str) -> Result<[f64; 3], PhysicsError> {
+        let b = self.id(mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_BODY, body)?;
+        Ok(match &self.engine {
+            Engine::Mujoco(d) => d.xpos()[b],
+            Engine::Rapier(w) => w.body_pose(b).translation.into(),
+        })
+    }
+
+    /// Sum of the contact normal forces on the named geom [N].
+    pub fn normal_force_on(&self, geom: &str) -> Result<f64, PhysicsError> {
+        let g = self.id(mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_GEOM, geom)?;
+        Ok(match &self.engine {
+            Engine::Mujoco(d) => d
+                .contact()
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.geom1 as usize == g || c.geom2 as usize == g)
+                .map(|(i, _)| d.contact_force(i)[0])
+                .sum(),
+            Engine::Rapier(w) => {
+                let all: Vec<usize> = (0..self.model.ffi().ngeom as usize).collect();
+                w.normal_force_between(&[g], &all).0
+            }
+        })
+    }
+}
