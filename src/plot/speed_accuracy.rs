@@ -308,12 +308,13 @@ impl Chart for SpeedAccuracy {
     }
 }
 
-/// The marker of backend number `m` at a data point.
+/// The marker of backend number `m` at a data point: circle, cross, then triangle (the black
+/// triangle is the reference run's, so the second backend gets the cross).
 fn marker<DB: DrawingBackend>(m: usize, at: (f64, f64), color: RGBColor) -> DynElement<'static, DB, (f64, f64)> {
     match m % 3 {
         0 => Circle::new(at, 6, color.filled()).into_dyn(),
-        1 => TriangleMarker::new(at, 7, color.filled()).into_dyn(),
-        _ => Cross::new(at, 6, color.stroke_width(3)).into_dyn(),
+        1 => Cross::new(at, 7, color.stroke_width(4)).into_dyn(),
+        _ => TriangleMarker::new(at, 7, color.filled()).into_dyn(),
     }
 }
 
@@ -321,7 +322,7 @@ fn marker<DB: DrawingBackend>(m: usize, at: (f64, f64), color: RGBColor) -> DynE
 fn marker_px<DB: DrawingBackend>(m: usize, at: (i32, i32), color: RGBColor) -> DynElement<'static, DB, (i32, i32)> {
     match m % 3 {
         0 => Circle::new(at, 6, color.filled()).into_dyn(),
-        1 => TriangleMarker::new(at, 7, color.filled()).into_dyn(),
-        _ => Cross::new(at, 6, color.stroke_width(3)).into_dyn(),
+        1 => Cross::new(at, 7, color.stroke_width(4)).into_dyn(),
+        _ => TriangleMarker::new(at, 7, color.filled()).into_dyn(),
     }
 }

@@ -1,5 +1,6 @@
 //! Speed against accuracy: one scenario over timestep × integrator × friction cone × finger
-//! links, each compared with a reference run (smallest timestep, finest finger).
+//! links on MuJoCo, and timestep × solver iterations × finger links on rapier, each compared
+//! with one reference run (MuJoCo, smallest timestep, finest finger).
 //!
 //! Accuracy is the RMS difference of the true sensor-force trace from the reference's, tick by
 //! tick while the object should be held, and the drop-time difference. The runs are made without
@@ -21,7 +22,10 @@ pub struct Grid {
     pub cones: Vec<&'static str>,
     /// Finger links.
     pub segments: Vec<u32>,
-    /// The reference: timestep [s] and links (implicit integrator, elliptic cone).
+    /// rapier solver iterations per step (the rapier series; empty: MuJoCo only). rapier has one
+    /// integrator and its own friction cone, so its points vary iterations instead.
+    pub rapier_iterations: Vec<u32>,
+    /// The reference: timestep [s] and links (MuJoCo, implicit integrator, elliptic cone).
     pub reference: (f64, u32),
 }
 
@@ -33,6 +37,7 @@ impl Grid {
             integrators: vec!["euler", "implicitfast", "implicit", "rk4"],
             cones: vec!["pyramidal", "elliptic"],
             segments: vec![6, 8, 12],
+            rapier_iterations: vec![4, 8],
             reference: (0.0005, 16),
         }
     }
@@ -44,19 +49,53 @@ impl Grid {
             integrators: vec!["implicitfast", "euler"],
             cones: vec!["elliptic"],
             segments: vec![8],
+            rapier_iterations: vec![8],
             reference: (0.001, 12),
         }
     }
 }
 
-fn settings(dt: f64, integrator: &str, cone: &str, segments: u32) -> Vec<crate::scenario::Override> {
-    vec![
-        set("physics.timestep_s", dt),
-        set("physics.integrator", format!("\"{integrator}\"")),
-        set("physics.cone", format!("\"{cone}\"")),
-        set("finger.segments", segments),
-        set("feedback", false),
-    ]
+/// One point of the grid: the backend's own axes (MuJoCo: integrator and cone; rapier: solver
+/// iterations, with the integrator and cone columns naming what rapier does instead).
+#[derive(Debug, Clone, PartialEq)]
+struct Point {
+    timestep_s: f64,
+    integrator: String,
+    cone: String,
+    segments: u32,
+    rapier_iterations: Option<u32>,
+}
+
+impl Point {
+    fn mujoco(timestep_s: f64, integrator: &str, cone: &str, segments: u32) -> Point {
+        Point { timestep_s, integrator: integrator.into(), cone: cone.into(), segments, rapier_iterations: None }
+    }
+
+    fn rapier(timestep_s: f64, iterations: u32, segments: u32) -> Point {
+        Point {
+            timestep_s,
+            integrator: format!("pgs ({iterations} it.)"),
+            cone: "coulomb".into(),
+            segments,
+            rapier_iterations: Some(iterations),
+        }
+    }
+
+    fn overrides(&self) -> Vec<crate::scenario::Override> {
+        let mut o = vec![
+            set("physics.timestep_s", self.timestep_s),
+            set("finger.segments", self.segments),
+            set("feedback", false),
+        ];
+        match self.rapier_iterations {
+            None => o.extend([
+                set("physics.integrator", format!("\"{}\"", self.integrator)),
+                set("physics.cone", format!("\"{}\"", self.cone)),
+            ]),
+            Some(it) => o.extend([set("physics.backend", "\"rapier\""), set("physics.rapier.solver_iterations", it)]),
+        }
+        o
+    }
 }
 
 /// RMS difference of two runs' true sensor force over the ticks both have in holding phases,
@@ -80,25 +119,25 @@ fn trace_rmse(run: &StudyRun, reference: &StudyRun) -> Option<f64> {
 /// `defaults` names the project's default settings (timestep, integrator, cone, links) to
 /// highlight. Returns the files written.
 pub fn run(scenario: &Path, grid: &Grid, defaults: (f64, &str, &str, u32), out: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let mut sets = vec![settings(grid.reference.0, "implicit", "elliptic", grid.reference.1)];
-    let mut labels = vec![(grid.reference.0, "implicit", "elliptic", grid.reference.1)];
+    let mut labels = vec![Point::mujoco(grid.reference.0, "implicit", "elliptic", grid.reference.1)];
     for &dt in &grid.timesteps_s {
-        for &integrator in &grid.integrators {
-            for &cone in &grid.cones {
-                for &segments in &grid.segments {
-                    sets.push(settings(dt, integrator, cone, segments));
-                    labels.push((dt, integrator, cone, segments));
+        for &segments in &grid.segments {
+            for &integrator in &grid.integrators {
+                for &cone in &grid.cones {
+                    labels.push(Point::mujoco(dt, integrator, cone, segments));
                 }
             }
+            labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
         }
     }
-    let runs = run_all(scenario, sets, 1)?;
+    let default = Point::mujoco(defaults.0, defaults.1, defaults.2, defaults.3);
+    let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), 1)?;
     let reference = &runs[0];
     let rows: Vec<SpeedAccuracyRow> = runs
         .iter()
         .zip(&labels)
         .enumerate()
-        .map(|(i, (r, &(dt, integrator, cone, segments)))| {
+        .map(|(i, (r, point))| {
             let ok = r.summary.outcome != "error";
             let drop_error = match (r.summary.drop_time_s, reference.summary.drop_time_s) {
                 (Some(a), Some(b)) => Some((a - b).abs()),
@@ -106,10 +145,10 @@ pub fn run(scenario: &Path, grid: &Grid, defaults: (f64, &str, &str, u32), out: 
             };
             SpeedAccuracyRow {
                 backend: r.summary.run.backend.clone(),
-                integrator: integrator.into(),
-                cone: cone.into(),
-                timestep_s: dt,
-                segments,
+                integrator: point.integrator.clone(),
+                cone: point.cone.clone(),
+                timestep_s: point.timestep_s,
+                segments: point.segments,
                 sim_s_per_wall_s: ok.then_some(r.summary.real_time_factor),
                 force_rmse_n: if i == 0 {
                     Some(0.0)
@@ -120,7 +159,7 @@ pub fn run(scenario: &Path, grid: &Grid, defaults: (f64, &str, &str, u32), out: 
                 },
                 drop_time_error_s: if ok { drop_error } else { None },
                 status: if ok { "ok".into() } else { "diverged".into() },
-                is_default: (dt, integrator, cone, segments) == defaults && i != 0,
+                is_default: *point == default && i != 0,
                 is_reference: i == 0,
             }
         })

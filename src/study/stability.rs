@@ -1,6 +1,6 @@
-//! Stability where numerical methods fail: for each integrator, the scenario at growing
-//! timesteps, classified as stable, diverged, too deep a penetration, or a lost grasp (the
-//! object dropped although the run at the project's defaults holds it).
+//! Stability where numerical methods fail: for each MuJoCo integrator and for rapier, the
+//! scenario at growing timesteps, classified as stable, diverged, too deep a penetration, or a
+//! lost grasp (the object dropped although the run at the project's defaults holds it).
 
 use super::{cell, run_all, set, write_csv};
 use crate::plot::stability::{StabilityRow, render};
@@ -8,8 +8,10 @@ use std::path::{Path, PathBuf};
 
 /// Timesteps tried [s], from MuJoCo's usual 1 ms to the largest a scenario accepts (50 ms).
 pub const TIMESTEPS_S: [f64; 7] = [0.001, 0.002, 0.005, 0.01, 0.02, 0.03, 0.05];
-/// Integrators compared.
+/// MuJoCo integrators compared.
 pub const INTEGRATORS: [&str; 4] = ["euler", "implicitfast", "implicit", "rk4"];
+/// The rapier series' label (rapier steps with its PGS solver and symplectic Euler).
+pub const RAPIER_SERIES: &str = "pgs";
 
 /// Runs the study on `scenario` (which should hold its object at the defaults), writes
 /// `stability.csv` and its chart into `out`. `threads` workers.
@@ -21,6 +23,11 @@ pub fn run(scenario: &Path, timesteps: &[f64], out: &Path, threads: usize) -> an
             sets.push(vec![set("physics.timestep_s", dt), set("physics.integrator", format!("\"{integrator}\""))]);
             labels.push((integrator, dt));
         }
+    }
+    // rapier at its default solver iterations: one series (it has one integrator).
+    for &dt in timesteps {
+        sets.push(vec![set("physics.timestep_s", dt), set("physics.backend", "\"rapier\"")]);
+        labels.push((RAPIER_SERIES, dt));
     }
     let runs = run_all(scenario, sets, threads)?;
     let held_at_defaults = runs[0].summary.outcome == "held";

@@ -77,3 +77,40 @@ impl PhysicsHooks for ContactRules {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::physics::{PhysicsConfig, SceneModel, SceneSpec, validation};
+    use mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_GEOM;
+
+    fn geom(m: &MjModel, name: &str) -> usize {
+        m.name_to_id(mjOBJ_GEOM, name).unwrap()
+    }
+
+    #[test]
+    fn pads_touch_the_box_not_each_other() {
+        let m = validation::pinch(&PhysicsConfig::default(), 0.7).unwrap();
+        let rules = ContactRules::from_model(&m);
+        let (l, r, b) = (geom(&m, "pad_l"), geom(&m, "pad_r"), geom(&m, "box"));
+        assert_eq!(rules.friction(l, b), Some(0.7));
+        assert_eq!(rules.friction(b, r), Some(0.7));
+        assert!(!rules.collide(l, r));
+    }
+
+    #[test]
+    fn the_object_sets_the_grip_friction_and_the_strip_skips_its_own_joints() {
+        let scene = SceneModel::build(&SceneSpec::default()).unwrap();
+        let m = scene.model();
+        let rules = ContactRules::from_model(m);
+        // priority 1 on the object: its 1.07 wins over the strip's default 1.
+        assert_eq!(
+            rules.friction(geom(m, "seg3"), geom(m, "object_grip")),
+            Some(m.geom_friction()[geom(m, "object_grip")][0])
+        );
+        // The guide walls hold the strip; the strip never touches itself or the table.
+        assert!(rules.collide(geom(m, "guide_wall_in"), geom(m, "seg0")));
+        assert!(!rules.collide(geom(m, "seg1"), geom(m, "seg2")));
+        assert!(!rules.collide(geom(m, "seg1"), geom(m, "table")));
+    }
+}
