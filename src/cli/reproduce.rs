@@ -20,10 +20,14 @@ pub struct ReproduceArgs {
     /// The twin's physics engine for Sec. V, `mujoco` or `rapier` (default: the scenarios' own).
     #[arg(long)]
     backend: Option<crate::cell::physics::Backend>,
+    /// Override a value of the Sec. V scenarios: `--set key.path=value` (repeatable).
+    #[arg(long = "set")]
+    set: Vec<Override>,
 }
 
 pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
-    let overrides: Vec<Override> = a.backend.map(Override::backend).into_iter().collect();
+    let mut overrides = a.set.clone();
+    overrides.extend(a.backend.map(Override::backend));
     let rows = reproduce_rows(&a.what, &a.scenarios, &overrides)?;
     emit(&render_table(&rows));
     if let Some(path) = a.json {

@@ -82,8 +82,10 @@ pub enum RapierFriction {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RapierConfig {
-    /// Solver iterations per step. 8: modeling.md saw a 12-link chain track its spring targets to
-    /// 0.03 rad at 4 as a multibody; the finger's contacts with a 0.4 kg object want more.
+    /// Solver iterations per step. 8: 4 run 1.8x faster, but in the speed/accuracy study (crimper,
+    /// 5 ms, 8 links, against the MuJoCo reference) the drop lands 1.5 s off with 4 and 0.2 s with 8
+    /// (force RMSE 0.14 vs 0.12 N). modeling.md saw a 12-link multibody chain track its spring
+    /// targets to 0.03 rad at 4; the contacts with a 0.4 kg object are what want more.
     pub solver_iterations: u32,
     /// Internal PGS iterations per solver iteration.
     pub pgs_iterations: u32,
@@ -92,9 +94,14 @@ pub struct RapierConfig {
     /// Friction model between rigid bodies. `simplified`: modeling.md measured the slip angle within
     /// 0.03 deg of atan(mu) with it, where the Coulomb model slips about 1.5 deg early.
     pub friction_model: RapierFriction,
-    /// Natural frequency of the contact constraints' softness [Hz] (rapier's default 30).
+    /// Natural frequency of the contact constraints' softness [Hz]. rapier's default, 30.
     pub contact_frequency_hz: f64,
-    /// Damping ratio of the contact constraints' softness (rapier's default).
+    /// Damping ratio of the contact constraints' softness. Tuned: 5 (rapier's default is 10), the
+    /// one of six settings tried (16/30 Hz with 1 and 5, 60 Hz with 5, 30 Hz with 10) that reproduces the most of the paper's Sec. V with
+    /// MuJoCo's calibration (11 of 15 rows, `tendril reproduce gripper --backend rapier --set
+    /// physics.rapier.contact_damping_ratio=...`); with 10 the crimper and the shampoo ring at
+    /// lift-off (52 and 43 % fluctuation, limit 40 %). The no-feedback drop times move by seconds
+    /// across these settings (models/README.md).
     pub contact_damping_ratio: f64,
     /// Length scale of rapier's tolerances [m]: slop 0.005 x, speculative margin 0.02 x. rapier is
     /// tuned for metre-sized bodies (slop 5 mm); the finger is 2 mm thick and grips 25 mm handles,
