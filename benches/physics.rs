@@ -77,10 +77,10 @@ fn physics(c: &mut Criterion) {
         [("minimal_box_on_plane_1s", Backend::Mujoco), ("minimal_box_on_plane_rapier_1s", Backend::Rapier)]
     {
         let p = PhysicsConfig { backend, ..PhysicsConfig::default() };
+        let model = std::sync::Arc::new(validation::box_on_plane(&p).expect("builds"));
         c.bench_function(name, |b| {
             b.iter(|| {
-                let model = validation::box_on_plane(&p).expect("builds");
-                let mut run = ValidationRun::new(model, &p).expect("starts");
+                let mut run = ValidationRun::new(model.clone(), &p).expect("starts");
                 run.run_for(1.0).expect("steps");
                 black_box(run.body_position("box").expect("has a box")[2])
             })

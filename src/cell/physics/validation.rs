@@ -47,9 +47,9 @@ enum Engine {
 }
 
 impl ValidationRun {
-    /// Starts `model` at its `qpos0` on the backend `p` names.
-    pub fn new(model: MjModel, p: &PhysicsConfig) -> Result<ValidationRun, PhysicsError> {
-        let model = std::sync::Arc::new(model);
+    /// Starts `model` (a model, or one shared by several runs) at its `qpos0` on the backend `p` names.
+    pub fn new(model: impl Into<std::sync::Arc<MjModel>>, p: &PhysicsConfig) -> Result<ValidationRun, PhysicsError> {
+        let model = model.into();
         let engine = match p.backend {
             super::Backend::Mujoco => {
                 let mut d = mujoco_rs::prelude::MjData::new(model.clone());
