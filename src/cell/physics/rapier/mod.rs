@@ -9,12 +9,14 @@
 //! on this kind of machine (../shared/reference/modeling.md): the finger is a reduced-coordinate
 //! multibody (impulse joints let a 12-link chain drift and drop the object), f64 throughout.
 //!
-//! - [`world`]: the translation and the stepping ([`RapierWorld`]).
+//! - [`translate`]: the compiled MuJoCo model -> a rapier world ([`RapierWorld::build`]).
+//! - [`world`]: stepping it and reading it back by MuJoCo ids ([`RapierWorld`]).
 //! - [`contacts`]: MuJoCo's collision filter and friction mix as rapier hooks.
 //! - [`scene`]: the cell's run on it ([`RapierScene`]).
 
 pub mod contacts;
 pub mod scene;
+pub mod translate;
 pub mod world;
 
 pub use scene::RapierScene;
