@@ -51,8 +51,9 @@ fn bad_backend_settings_name_the_file_and_key() {
 }
 
 /// The rows rapier reproduces with MuJoCo's calibration (models/README.md, "The rapier backend"):
-/// every feedback row (held, rise, fluctuation) and the crimper's drop in the lift. The shampoo and
-/// hammer drops without feedback move (later and earlier) and are reported, not asserted.
+/// every feedback row (held, rise, fluctuation) and the crimper's drop in the lift. Without feedback
+/// rapier carries the shampoo further (it drops while lowering) and the hammer to the end: reported,
+/// not asserted.
 const RAPIER_AGREES: [&str; 11] = [
     "crimper, no feedback: outcome",
     "crimper, no feedback: drop time after the arm starts [s]",

@@ -97,11 +97,13 @@ pub struct RapierConfig {
     /// Natural frequency of the contact constraints' softness [Hz]. rapier's default, 30.
     pub contact_frequency_hz: f64,
     /// Damping ratio of the contact constraints' softness. Tuned: 5 (rapier's default is 10), the
-    /// one of six settings tried (16/30 Hz with 1 and 5, 60 Hz with 5, 30 Hz with 10) that
-    /// reproduces the most of the paper's Sec. V with MuJoCo's calibration (11 of 15 rows,
-    /// `tendril reproduce gripper --backend rapier --set physics.rapier.contact_damping_ratio=...`);
-    /// with 10 the crimper and the shampoo ring at lift-off (52 and 43 % fluctuation, limit 40 %).
-    /// The no-feedback drop times move by seconds across these settings (models/README.md).
+    /// setting, of six tried (16/30 Hz with 1 and 5, 60 Hz with 5, 30 Hz with 10), that reproduces
+    /// the most of the paper's Sec. V with MuJoCo's calibration (11 of 15 rows, `tendril reproduce
+    /// gripper --backend rapier --set physics.rapier.contact_damping_ratio=...`) and passes the
+    /// analytic validation: 1 reproduces 12 but lets the pinch test's pads sink 5 mm into the box
+    /// (contacts too soft); 10 makes the crimper and the shampoo ring at lift-off (52 and 43 %
+    /// fluctuation, limit 40 %). The no-feedback drop times move by seconds across these settings
+    /// (models/README.md).
     pub contact_damping_ratio: f64,
     /// Length scale of rapier's tolerances [m]: slop 0.005 x, speculative margin 0.02 x. rapier is
     /// tuned for metre-sized bodies (slop 5 mm); the finger is 2 mm thick and grips 25 mm handles,
