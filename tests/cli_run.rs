@@ -88,6 +88,9 @@ fn bad_keys_and_values_name_the_file_and_key_and_exit_non_zero() {
         ("object.name=anvil", "object.name"),
         ("physics.timestep_s=0", "physics.timestep_s"),
         ("setpoint_n=9", "setpoint_n"),
+        ("hardware.dxl_baud=56000", "hardware.dxl_baud"),
+        ("hardware.growth_id=2", "hardware.twine_id"),
+        ("hardware.fbg.fbg1_max_nm=1545", "hardware.fbg.fbg1_max_nm"),
     ] {
         let out = tendril(&["run", "scenarios/crimper.toml", "--set", set]);
         let err = stderr(&out);

@@ -8,10 +8,9 @@
 use std::net::{IpAddr, Ipv4Addr};
 use std::process::Command;
 use tendril::cell::real::serve::{ServeConfig, start};
-use tendril::run::scenario::PickPlaceScenario;
 
 mod common;
-use common::one_at_a_time;
+use common::{one_at_a_time, short_lift};
 
 fn python() -> Option<String> {
     match std::env::var("TENDRIL_PYTHON") {
@@ -23,11 +22,6 @@ fn python() -> Option<String> {
             None
         }
     }
-}
-
-fn scenario() -> PickPlaceScenario {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
-    tendril::scenario::load(&path, &[]).unwrap()
 }
 
 fn run_script(python: &str, script: &str, args: &[&str]) -> serde_json::Value {
@@ -50,7 +44,7 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
     let mut config = ServeConfig::loopback().with_port_base(39740);
     config.bind = IpAddr::V4(Ipv4Addr::new(127, 0, 0, 74));
     config.rtde_port = 30004;
-    let serve = start(&scenario(), &config).unwrap();
+    let serve = start(&short_lift(&[]), &config).unwrap();
     let v = run_script(&python, "ur_rtde_receive.py", &["127.0.0.74"]);
     let twin = serve.state.lock().unwrap().status;
     serve.stop().unwrap();
@@ -69,7 +63,7 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
 fn dynamixel_sdk_pings_model_321_and_moves_the_growth_motor() {
     let _turn = one_at_a_time();
     let Some(python) = python() else { return };
-    let serve = start(&scenario(), &ServeConfig::loopback().with_port_base(39750)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39750)).unwrap();
     let pty = serve.pty_path.to_string_lossy().to_string();
     let goal = 300; // ticks: 0.46 rad, 5.5 mm of finger growth on the 12 mm pinion
     let v = run_script(&python, "dynamixel_sdk_client.py", &[&pty, &goal.to_string()]);

@@ -1,66 +1,29 @@
-//! End to end: the real path (`RealCell` behind `LimitedCell`, RTDE + URScript + Dynamixel pty +
-//! HYPERION) against the virtual devices running the twin in real time, on the short grasp-hold-
-//! lift scenario (about 13 s of wall time), compared with the same scenario on the simulated path.
-//!
-//! Tolerances: the real path's timing jitters (ticks land a fraction of a millisecond late, the
-//! twin steps on its own clock), so traces are not identical; phase medians of the force estimate
-//! must agree within 0.1 N (a sixth of the 0.6 N setpoint, about 40 times the sensor's 2.6 mN
-//! resolution) while the arm stands still, within 0.2 N (a third of the setpoint) during the lift,
-//! and phase durations within 0.2 s. The lift is looser because the moment the object's weight
-//! comes off the table, and the force transient after it, move with the tick timing: on an idle
-//! machine the medians agree within 5 mN, on a loaded 2-core machine they were seen 0.10 N apart.
+//! The real path (`RealCell` behind `LimitedCell`, RTDE + URScript + Dynamixel pty + HYPERION)
+//! in-process against the virtual devices running the twin in real time, on the short grasp-hold-
+//! lift scenario (about 13 s of wall time), compared with the same scenario on the simulated path
+//! within the tolerances of `common::phases`. `tests/serve_run_e2e.rs` does the same with the two
+//! binaries; here the twin's ground truth is at hand, and the devices' state after a stop.
 
 use tendril::cell::real::RealCellConfig;
 use tendril::cell::real::serve::{ServeConfig, start};
 use tendril::run::execute::run_on_twin;
 use tendril::run::real::run_on_real;
-use tendril::run::runner::{Outcome, RunReport};
-use tendril::run::scenario::PickPlaceScenario;
+use tendril::run::runner::Outcome;
 
 mod common;
-use common::one_at_a_time;
-
-/// The short grasp-hold-lift scenario every test here runs.
-fn short_lift() -> PickPlaceScenario {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
-    tendril::scenario::load(&path, &[]).unwrap()
-}
-
-/// A real-cell configuration pointing at the virtual devices of `serve` on loopback.
-fn config_for(serve: &tendril::cell::real::serve::ServeHandle) -> RealCellConfig {
-    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
-    config.rtde_port = serve.addrs[0].port();
-    config.script_port = serve.addrs[1].port();
-    config.command_port = serve.addrs[2].port();
-    config.stream_port = serve.addrs[3].port();
-    config
-}
-
-fn phase_stats(report: &RunReport, phase: &str) -> (f64, f64) {
-    let rows: Vec<_> = report.rows.iter().filter(|r| r.phase.name() == phase).collect();
-    assert!(!rows.is_empty(), "no {phase} rows");
-    // The median: the lift has force spikes of several newtons as the object shifts in the hand,
-    // whose timing the real path's jitter moves; the median is what the hand holds with.
-    let mut forces: Vec<f64> = rows.iter().map(|r| r.force_n).collect();
-    forces.sort_by(f64::total_cmp);
-    let median = forces[forces.len() / 2];
-    let duration = rows.last().unwrap().time_s - rows[0].time_s;
-    (median, duration)
-}
+use common::{loose_watchdog, one_at_a_time, phases, short_lift};
 
 #[test]
 fn real_path_against_virtual_devices_matches_the_twin() {
     let _turn = one_at_a_time();
-    let scenario = short_lift();
+    let scenario = short_lift(&[]);
     let (_, sim) = run_on_twin(&scenario, &Default::default(), None).unwrap();
     assert_eq!(sim.outcome, Outcome::Held, "the short scenario must hold on the twin: {:?}", sim.error);
 
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39710)).unwrap();
-    let mut config = config_for(&serve);
-    // CI shares 2 cores between the twin, the client and the build: a loose watchdog (100 ms)
-    // so a scheduling hiccup does not end the run; the watchdog itself is tested below.
-    config.sensor_stale_samples = 100.0;
-    config.arm_stale_s = 0.1;
+    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    // The watchdog itself is tested below.
+    loose_watchdog(&mut config);
     // The real path has no ground truth; the twin behind the devices has. Sample its contact
     // flag through the run, to judge the outcome as the simulated path does (the object counts as
     // lost after 0.3 s without contact once grasped).
@@ -95,28 +58,14 @@ fn real_path_against_virtual_devices_matches_the_twin() {
     assert!(longest_no_contact_s < 0.3, "object lost: {longest_no_contact_s:.2} s without contact");
     // Not compared: the sensor-based slip detector's events, which near its thresholds are decided
     // by noise; the ground truth above is the outcome.
-    let names: Vec<_> = real.rows.iter().map(|r| r.phase.name()).collect();
-    for phase in ["grow", "wrap", "grasp", "lift"] {
-        assert!(names.contains(&phase), "real run never reached {phase}");
-        let (f_sim, d_sim) = phase_stats(&sim, phase);
-        let (f_real, d_real) = phase_stats(&real, phase);
-        eprintln!(
-            "{phase}: median force sim {f_sim:.3} N real {f_real:.3} N; duration sim {d_sim:.2} s real {d_real:.2} s"
-        );
-        let tolerance_n = if phase == "lift" { 0.2 } else { 0.1 };
-        assert!(
-            (f_sim - f_real).abs() < tolerance_n,
-            "{phase}: median force sim {f_sim:.3} N, real {f_real:.3} N (tolerance {tolerance_n} N)"
-        );
-        assert!((d_sim - d_real).abs() < 0.2, "{phase}: duration sim {d_sim:.2} s, real {d_real:.2} s");
-    }
+    phases::assert_phases_agree(&phases::from_report(&sim), &phases::from_report(&real));
 }
 
 #[test]
 fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
     let _turn = one_at_a_time();
     use std::io::{Read, Write};
-    let scenario = short_lift();
+    let scenario = short_lift(&[]);
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39720)).unwrap();
     let timeout = Some(std::time::Duration::from_secs(2));
     // RTDE: a size field below the header length.
@@ -151,9 +100,9 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
 fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
     let _turn = one_at_a_time();
     use tendril::hardware::Cell;
-    let scenario = short_lift();
+    let scenario = short_lift(&[]);
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39730)).unwrap();
-    let config = config_for(&serve);
+    let config = RealCellConfig::for_virtual_devices(&serve);
     let mut cell = tendril::cell::real::RealCell::new(config);
     cell.configure().unwrap();
     cell.activate().unwrap();
@@ -172,11 +121,10 @@ fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
 fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
     let _turn = one_at_a_time();
     use tendril::hardware::{Cell, CellCommand};
-    let scenario = short_lift();
+    let scenario = short_lift(&[]);
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39760)).unwrap();
-    let mut config = config_for(&serve);
-    config.sensor_stale_samples = 100.0;
-    config.arm_stale_s = 0.1;
+    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    loose_watchdog(&mut config);
     let mut cell = tendril::cell::real::RealCell::new(config);
     cell.configure().unwrap();
     cell.activate().unwrap();
@@ -211,5 +159,48 @@ fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on
         twine.present_position()
     );
     drop(s);
+    serve.stop().unwrap();
+}
+
+#[test]
+fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
+    let _turn = one_at_a_time();
+    use tendril::cell::real::protocol::dynamixel::control_table::addr;
+    use tendril::cell::real::{HardwareConfig, RealCell};
+    use tendril::hardware::{Cell, CellCommand};
+    let scenario = short_lift(&[
+        "hardware.growth_id=11",
+        "hardware.twine_id=12",
+        "hardware.dxl_baud=1000000",
+        "hardware.fbg.channel=3",
+    ]);
+    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39770)).unwrap();
+    {
+        let s = serve.state.lock().unwrap();
+        assert_eq!(s.bus.ids(), [11, 12]);
+        assert_eq!(s.bus.table(11).unwrap().read(addr::BAUD_RATE, 1).unwrap(), [3], "1 Mbit/s is Baud Rate 3");
+    }
+    // The real path with the same [hardware] finds both motors and both gratings on channel 3.
+    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    assert_eq!(config.hardware, scenario.hardware);
+    loose_watchdog(&mut config);
+    let mut cell = RealCell::new(config.clone());
+    cell.configure().unwrap();
+    cell.activate().unwrap();
+    for k in 1..=20 {
+        let s = cell.read().unwrap();
+        assert!(s.wavelengths.fbg1_nm > 1535.0 && s.wavelengths.fbg2_nm > 1547.8, "{:?}", s.wavelengths);
+        let c = CellCommand { arm_q: s.arm_q, growth_motor_rad: 0.0, twine_motor_rad: 0.5 };
+        cell.write(&c).unwrap();
+        cell.wait_until(k as f64 * 0.01).unwrap();
+    }
+    let twine = serve.state.lock().unwrap().bus.table(12).unwrap().goal_position();
+    assert!(twine > 250, "the twine motor (ID 12) is driven to 0.5 rad (326 ticks): goal {twine} ticks");
+    cell.deactivate().unwrap();
+    drop(cell);
+    // The factory IDs are not on this bus: configuring for them fails and says which is missing.
+    config.hardware = HardwareConfig { fbg: scenario.hardware.fbg, ..HardwareConfig::default() };
+    let err = RealCell::new(config).configure().unwrap_err().to_string();
+    assert!(err.contains("ID 1 did not answer"), "{err}");
     serve.stop().unwrap();
 }

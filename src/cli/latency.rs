@@ -1,7 +1,8 @@
 //! `tendril latency`: the real path against the virtual devices on loopback, at 500 Hz.
 
 use super::emit;
-use crate::cell::real::latency::measure;
+use crate::cell::real::latency::{LatencyReport, measure, measure_idle};
+use crate::cell::real::realtime::RealtimeOptions;
 use crate::cell::real::serve::{ServeConfig, start};
 use crate::cell::real::{RealCell, RealCellConfig};
 use crate::run::scenario::PickPlaceScenario;
@@ -21,50 +22,80 @@ pub struct LatencyArgs {
     #[arg(long, default_value_t = 500.0)]
     rate_hz: f64,
     /// Ports of the virtual devices (N .. N+3 on 127.0.0.1).
-    #[arg(long, default_value_t = 39400)]
+    #[arg(long, default_value_t = 39400, value_parser = super::devices::port_base)]
     port_base: u16,
-    /// Sensor watchdog [interrogator periods]; looser than a run's 5 so a scheduling hiccup of a
-    /// loaded machine shows up in the figures instead of ending the measurement.
-    #[arg(long, default_value_t = 50.0)]
+    /// Sensor watchdog [interrogator periods], also the arm watchdog and the motors' reply timeout
+    /// (500: 0.5 s); far looser than a run's, so that the thread not being run for a while (tens
+    /// of ms on a shared virtual machine) shows up in the figures instead of ending the measurement.
+    #[arg(long, default_value_t = 500.0)]
     sensor_stale_samples: f64,
-    /// Run the control thread and the twin/bus threads under SCHED_FIFO at this priority (1-99;
-    /// needs root or CAP_SYS_NICE); 0 leaves normal scheduling.
-    #[arg(long, default_value_t = 0)]
-    rt_priority: i32,
+    #[command(flatten)]
+    realtime: super::realtime::RealtimeArgs,
+    /// Run the virtual devices' threads (twin, bus, network) on this CPU only; with `--cpu` for
+    /// the control thread, the two stop competing for one core.
+    #[arg(long)]
+    devices_cpu: Option<usize>,
+    /// First run the same schedule with no work in a tick for as long, on the same thread: the
+    /// latency and missed deadlines the machine alone gives.
+    #[arg(long)]
+    floor: bool,
 }
 
 pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(a.seconds > 0.0 && a.seconds <= 3600.0, "--seconds must be in (0, 3600]");
     anyhow::ensure!(a.rate_hz > 0.0 && a.rate_hz <= 2000.0, "--rate-hz must be in (0, 2000]");
+    anyhow::ensure!(
+        a.sensor_stale_samples.is_finite() && a.sensor_stale_samples >= 1.0,
+        "--sensor-stale-samples must be at least 1"
+    );
     let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &[])?;
-    let mut serve_config = ServeConfig::loopback().with_port_base(a.port_base);
-    serve_config.rt_priority = a.rt_priority;
-    let serve = start(&scenario, &serve_config)?;
-    let mut config = RealCellConfig::new("127.0.0.1", &serve.pty_path.to_string_lossy(), "127.0.0.1");
-    config.rtde_port = serve.addrs[0].port();
-    config.script_port = serve.addrs[1].port();
-    config.command_port = serve.addrs[2].port();
-    config.stream_port = serve.addrs[3].port();
-    config.sensor_stale_samples = a.sensor_stale_samples;
-    config.arm_stale_s = a.sensor_stale_samples * 2e-3;
-    if a.rt_priority > 0 {
-        crate::cell::real::latency::set_realtime_priority(a.rt_priority)
-            .map_err(|e| anyhow::anyhow!("--rt-priority {}: {e}", a.rt_priority))?;
+    let control = a.realtime.options()?;
+    let label = format!("{} Hz for {} s", a.rate_hz, a.seconds);
+    if a.floor {
+        // On a thread scheduled as the control thread will be, before the devices start.
+        let idle =
+            std::thread::spawn(move || control.apply_to_current_thread().map(|()| measure_idle(a.rate_hz, a.seconds)));
+        let r = idle.join().map_err(|_| anyhow::anyhow!("the empty-tick thread panicked"))??;
+        emit(&format!("empty ticks (the machine alone), {label}: {}\n", describe(&r)));
     }
+    let mut serve_config = ServeConfig::loopback().with_port_base(a.port_base);
+    // The devices one level below the control thread: a real cell's devices have processors of
+    // their own, so here they must not hold up the tick they stand in for.
+    serve_config.realtime = RealtimeOptions {
+        priority: (control.priority - 1).max(control.priority.min(1)),
+        cpu: a.devices_cpu,
+        lock_memory: control.lock_memory,
+    };
+    let serve = start(&scenario, &serve_config)?;
+    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    config.sensor_period_s = 1.0 / scenario.interrogator.sample_rate_hz;
+    config.sensor_stale_samples = a.sensor_stale_samples;
+    config.arm_stale_s = a.sensor_stale_samples * config.sensor_period_s;
+    config.dxl_reply_timeout = std::time::Duration::from_secs_f64(config.arm_stale_s);
+    // After the devices started, so that they do not inherit the control thread's CPU.
+    control.apply_to_current_thread()?;
     let mut cell = RealCell::new(config);
     let r = measure(&mut cell, a.rate_hz, a.seconds)?;
     drop(cell);
     serve.stop().map_err(|e| anyhow::anyhow!("twin: {e}"))?;
     emit(&format!(
-        "real path vs virtual devices, {} Hz for {} s ({} ticks): latency p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms; missed deadlines {}; read+write alone p99 {:.3} ms\n",
-        a.rate_hz,
-        a.seconds,
+        "real path vs virtual devices, {label}: {}; read+write alone p99 {:.3} ms\n",
+        describe(&r),
+        r.work_p99_s * 1e3
+    ));
+    Ok(ExitCode::SUCCESS)
+}
+
+fn describe(r: &LatencyReport) -> String {
+    format!(
+        "{} ticks, latency p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms; missed deadlines {} ({:.2} %) from {} {}",
         r.ticks,
         r.p50_s * 1e3,
         r.p99_s * 1e3,
         r.max_s * 1e3,
         r.missed_deadlines,
-        r.work_p99_s * 1e3
-    ));
-    Ok(ExitCode::SUCCESS)
+        100.0 * r.missed_deadlines as f64 / r.ticks.max(1) as f64,
+        r.missed_runs,
+        if r.missed_runs == 1 { "stall" } else { "stalls" }
+    )
 }

@@ -5,6 +5,7 @@ mod devices;
 mod latency;
 mod physics;
 mod plot;
+mod realtime;
 mod reproduce;
 mod run;
 mod sensor;

@@ -36,9 +36,11 @@ pub struct RunArgs {
 }
 
 impl RunArgs {
-    /// `--seed` and `--feedback` are overrides like any `--set`, so they are validated alike.
+    /// `--seed`, `--feedback` and `--dxl-baud` are overrides like any `--set`, so they are
+    /// validated alike.
     fn overrides(&self) -> Vec<Override> {
         let mut o = self.set.clone();
+        o.extend(self.devices.overrides());
         if let Some(seed) = self.seed {
             o.push(Override { key: "seed".into(), value: toml::Value::Integer(seed as i64) });
         }
@@ -56,6 +58,8 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let (summary, _) = if a.hardware == "real" {
         let mut config = a.devices.config(&scenario)?;
         config.handle_ctrl_c = true;
+        // This thread runs the ticks; the cell's IO threads, started from it, inherit its priority.
+        a.devices.realtime()?.apply_to_current_thread()?;
         crate::run::real::run_on_real(&scenario, config, Some(&dir))?
     } else {
         run_on_twin(&scenario, &Default::default(), Some(&dir))?

@@ -19,7 +19,7 @@ pub struct ServeArgs {
     bind: IpAddr,
     /// Ports N (RTDE), N+1 (URScript), N+2 (HYPERION commands), N+3 (peaks) instead of the
     /// devices' 30004, 30002, 51971, 51972.
-    #[arg(long)]
+    #[arg(long, value_parser = super::devices::port_base)]
     port_base: Option<u16>,
     /// Stop after this many seconds (default: until Ctrl-C).
     #[arg(long)]
@@ -27,21 +27,29 @@ pub struct ServeArgs {
     /// Override a scenario value: `--set key.path=value` (repeatable).
     #[arg(long = "set")]
     set: Vec<Override>,
+    #[command(flatten)]
+    realtime: super::realtime::RealtimeArgs,
 }
 
 pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.set)?;
     let mut config = ServeConfig::loopback();
     config.bind = a.bind;
+    config.realtime = a.realtime.options()?;
     if let Some(base) = a.port_base {
         config = config.with_port_base(base);
     }
     let handle = start(&scenario, &config)?;
     let [rtde, script, command, stream] = handle.addrs;
+    let h = handle.hardware;
     emit(&format!(
-        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {script}\n  HYPERION  {command} (commands), {stream} (peaks)\n  Dynamixel {} (MX-106 IDs 1 growth, 2 twine)\n",
+        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {script}\n  HYPERION  {command} (commands), {stream} (peaks; FBG1, FBG2 on channel {})\n  Dynamixel {} (MX-106 IDs {} growth, {} twine; {} bit/s)\n",
         scenario.name,
-        handle.pty_path.display()
+        h.fbg.channel,
+        handle.pty_path.display(),
+        h.growth_id,
+        h.twine_id,
+        h.dxl_baud
     ));
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     {

@@ -12,6 +12,7 @@ use super::runner::ControlPlan;
 use super::summary::{Gains, RunIdentity};
 use crate::cell::fbg::{InterrogatorConfig, SensorConfig};
 use crate::cell::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneSpec};
+use crate::cell::real::HardwareConfig;
 use crate::cell::sim::EnvironmentConfig;
 use crate::control::estimate::ForceCalibration;
 use crate::control::gripper::GripperConfig;
@@ -71,6 +72,10 @@ pub struct PickPlaceScenario {
     /// The finger's physical parameters.
     #[serde(default)]
     pub finger: FingerConfig,
+    /// The real devices' settings (motor IDs, bus speed, FBG windows), for `--hardware real` and
+    /// `tendril serve`.
+    #[serde(default)]
+    pub hardware: HardwareConfig,
 }
 
 fn default_seed() -> u64 {
@@ -105,6 +110,7 @@ impl Validate for PickPlaceScenario {
         at.section("environment", &self.environment);
         at.section("physics", &self.physics);
         at.section("finger", &self.finger);
+        at.section("hardware", &self.hardware);
         let tendon_max_m = self.gripper.tendon_pull_m(self.gripper.twine_max_deg.to_radians());
         at.require("gripper.twine_max_deg", tendon_max_m <= self.finger.twine_max_m + 1e-9, || {
             format!(
@@ -116,10 +122,34 @@ impl Validate for PickPlaceScenario {
         at.require("task.growth_m", self.task.growth_m <= self.finger.length_m, || {
             format!("must not exceed finger.length_m ({} m)", self.finger.length_m)
         });
+        self.check_gratings_in_windows(at);
     }
 }
 
 impl PickPlaceScenario {
+    /// The FBG windows must hold the gratings `[sensor]` describes (the twin behind `tendril serve`
+    /// reports those; a real sensor should be described by them too): FBG1 from unloaded to the
+    /// top of the range (the backbone's shift at `range_n`, above the loading branch's), FBG2 at
+    /// its nominal wavelength.
+    fn check_gratings_in_windows(&self, at: &mut Checker) {
+        let (w, s) = (&self.hardware.fbg, &self.sensor);
+        let fbg1_top_nm = s.lambda1_nm + s.backbone_pm(s.range_n) * 1e-3;
+        at.require("hardware.fbg.fbg1_min_nm", w.fbg1_min_nm <= s.lambda1_nm, || {
+            format!("must not exceed sensor.lambda1_nm ({} nm), FBG1 unloaded", s.lambda1_nm)
+        });
+        at.require("hardware.fbg.fbg1_max_nm", !fbg1_top_nm.is_finite() || fbg1_top_nm < w.fbg1_max_nm, || {
+            format!(
+                "must exceed {fbg1_top_nm:.2} nm, FBG1 at the top of the sensor's range (sensor.lambda1_nm + the strain shift at sensor.range_n)"
+            )
+        });
+        at.require("hardware.fbg.fbg2_min_nm", (w.fbg2_min_nm..w.fbg2_max_nm).contains(&s.lambda2_nm), || {
+            format!(
+                "the FBG2 window [{}, {}) nm must hold sensor.lambda2_nm ({} nm)",
+                w.fbg2_min_nm, w.fbg2_max_nm, s.lambda2_nm
+            )
+        });
+    }
+
     /// The physics scene this scenario needs (arm starting at the task's home pose).
     pub fn scene_spec(&self) -> SceneSpec {
         SceneSpec {

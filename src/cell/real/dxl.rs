@@ -4,7 +4,8 @@
 //! we drive the bus with this project's own codec ([`InstructionPacket`], [`StreamDecoder`]) on a
 //! `serial2` port directly, so stuffing is the codec's (tested byte for byte against the manual)
 //! and no retry is needed. Blocking IO: one sync write and one sync read per tick, on the control
-//! thread, each bounded by [`REPLY_TIMEOUT`].
+//! thread, each bounded by a reply timeout ([`REPLY_TIMEOUT`] unless set otherwise); the sync read may be put on the bus ahead of the tick
+//! ([`GripperBus::request_present`]) so that the tick only collects its replies.
 //!
 //! Set-up: torque off, Operating Mode 4 (extended position: the growth pinion turns 1.9 times over
 //! the finger's length and the twine spool up to 680°, beyond one turn of mode 3), torque on, goal
@@ -13,7 +14,8 @@
 //! Safe state on stop: torque stays ON with goal = present position, so the finger holds the
 //! object instead of going limp (torque off would drop it).
 //! Timing: at 57 600 baud a sync write plus sync read of two motors takes about 6 ms on the wire,
-//! too slow for 500 Hz; real hardware should run the bus at 1 Mbps or more (`--dxl-baud`).
+//! too slow for 500 Hz; real hardware should run the bus at 1 Mbps or more (`hardware.dxl_baud`),
+//! and a USB adapter with its latency timer at 1 ms (FTDI's default is 16 ms).
 
 use super::protocol::dynamixel::control_table::addr;
 use super::protocol::dynamixel::units::{RAD_PER_TICK, rad_to_ticks};
@@ -21,7 +23,8 @@ use super::protocol::dynamixel::{Instruction, InstructionPacket, StatusPacket, S
 use serial2::SerialPort;
 use std::time::{Duration, Instant};
 
-/// Longest wait for a status packet.
+/// Longest wait for a status packet, by default: a motor answers within its Return Delay Time
+/// (0.5 ms at the factory setting) plus the wire time, so 50 ms only passes on a dead bus.
 pub const REPLY_TIMEOUT: Duration = Duration::from_millis(50);
 /// MX-106 model number (ping reply).
 pub const MX106_MODEL: u16 = 321;
@@ -38,6 +41,9 @@ pub struct GripperBus {
     pub twine_id: u8,
     offsets: [i32; 2],
     chunk: Vec<u8>,
+    reply_timeout: Duration,
+    /// A sync read of Present Position is on the bus, its replies not yet collected.
+    pending: bool,
 }
 
 fn err(cause: impl std::fmt::Display) -> String {
@@ -45,8 +51,14 @@ fn err(cause: impl std::fmt::Display) -> String {
 }
 
 impl GripperBus {
-    /// Opens the port (raw mode, `baud`), pings both motors (must be model 321) and sets them up.
-    pub fn open(path: &str, baud: u32, growth_id: u8, twine_id: u8) -> Result<GripperBus, String> {
+    /// Opens the port (raw mode, `baud`), pings both motors (must be model 321) and sets them up;
+    /// every reply must come within `reply_timeout`.
+    pub fn open(
+        path: &str,
+        baud: u32,
+        [growth_id, twine_id]: [u8; 2],
+        reply_timeout: Duration,
+    ) -> Result<GripperBus, String> {
         let mut port = SerialPort::open(path, baud).map_err(|e| err(format!("{path}: {e}")))?;
         port.set_read_timeout(Duration::from_millis(5)).map_err(err)?;
         let _ = port.discard_buffers();
@@ -57,6 +69,8 @@ impl GripperBus {
             twine_id,
             offsets: [0; 2],
             chunk: vec![0; 1024],
+            reply_timeout,
+            pending: false,
         };
         for id in [growth_id, twine_id] {
             let status = bus.transact(id, Instruction::Ping)?;
@@ -97,7 +111,7 @@ impl GripperBus {
 
     /// The next status packet from `id`, skipping echoes and other devices' replies.
     fn receive(&mut self, id: u8) -> Result<StatusPacket, String> {
-        let deadline = Instant::now() + REPLY_TIMEOUT;
+        let deadline = Instant::now() + self.reply_timeout;
         loop {
             while let Some(item) = self.decoder.next_packet() {
                 if let Ok(raw) = item
@@ -108,7 +122,7 @@ impl GripperBus {
                 }
             }
             if Instant::now() >= deadline {
-                return Err(err(format!("ID {id} did not answer within {REPLY_TIMEOUT:?}")));
+                return Err(err(format!("ID {id} did not answer within {:?}", self.reply_timeout)));
             }
             match self.port.read(&mut self.chunk) {
                 Ok(n) => self.decoder.push(&self.chunk[..n]),
@@ -118,15 +132,31 @@ impl GripperBus {
         }
     }
 
-    /// Present positions [growth, twine] in raw ticks (one sync read).
+    /// Puts a sync read of Present Position on the bus without waiting for the replies: the next
+    /// [`Self::present_rad`] collects them. Sent shortly before a tick, it takes the bus round trip
+    /// (a USB adapter's latency timer, the kernel's tty path) out of the tick.
+    pub fn request_present(&mut self) -> Result<(), String> {
+        if !self.pending {
+            self.send(&InstructionPacket {
+                id: super::protocol::dynamixel::BROADCAST_ID,
+                instruction: Instruction::SyncRead {
+                    address: addr::PRESENT_POSITION,
+                    length: 4,
+                    ids: vec![self.growth_id, self.twine_id],
+                },
+            })?;
+            self.pending = true;
+        }
+        Ok(())
+    }
+
+    /// Present positions [growth, twine] in raw ticks: the replies to the sync read requested
+    /// before, or to one sent now.
     fn present_ticks(&mut self) -> Result<[i32; 2], String> {
-        let ids = vec![self.growth_id, self.twine_id];
-        self.send(&InstructionPacket {
-            id: super::protocol::dynamixel::BROADCAST_ID,
-            instruction: Instruction::SyncRead { address: addr::PRESENT_POSITION, length: 4, ids: ids.clone() },
-        })?;
+        self.request_present()?;
+        self.pending = false;
         let mut out = [0i32; 2];
-        for (slot, id) in out.iter_mut().zip(ids) {
+        for (slot, id) in out.iter_mut().zip([self.growth_id, self.twine_id]) {
             let status = self.receive(id)?;
             let b = status.params.get(..4).ok_or_else(|| err(format!("ID {id}: short sync read reply")))?;
             *slot = i32::from_le_bytes([b[0], b[1], b[2], b[3]]);

@@ -6,6 +6,7 @@
 
 use super::protocol::Decoded;
 use super::protocol::hyperion::{FbgWindows, PeakSequence, Request, Response, SequenceCheck, decode_stream_frame};
+use super::tcp;
 use crate::signals::Wavelengths;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -40,10 +41,7 @@ fn err(cause: impl std::fmt::Display) -> String {
 
 /// Sends one command on a fresh command connection and returns the reply content.
 pub async fn command(addr: &str, command: &str, argument: &str) -> Result<Vec<u8>, String> {
-    let mut s = tokio::time::timeout(TIMEOUT, TcpStream::connect(addr))
-        .await
-        .map_err(|_| err(format!("{addr}: connect timed out")))?
-        .map_err(|e| err(format!("{addr}: {e}")))?;
+    let mut s = tcp::connect(addr, TIMEOUT).await.map_err(err)?;
     s.write_all(&Request::new(command, argument).encode().map_err(err)?).await.map_err(err)?;
     let mut buf = Vec::new();
     let mut chunk = [0u8; 4096];
@@ -83,11 +81,7 @@ pub async fn stream(
     addr: &str,
     windows: FbgWindows,
 ) -> Result<(Arc<Mutex<PeakFeed>>, tokio::task::JoinHandle<()>), String> {
-    let s = tokio::time::timeout(TIMEOUT, TcpStream::connect(addr))
-        .await
-        .map_err(|_| err(format!("{addr}: connect timed out")))?
-        .map_err(|e| err(format!("{addr}: {e}")))?;
-    s.set_nodelay(true).map_err(err)?;
+    let s = tcp::connect(addr, TIMEOUT).await.map_err(err)?;
     let feed = Arc::new(Mutex::new(PeakFeed::default()));
     let task = tokio::spawn(read_stream(s, windows, feed.clone()));
     Ok((feed, task))

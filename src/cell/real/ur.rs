@@ -5,11 +5,11 @@
 //! thread writes the targets and the enable flag as one input data package per tick.
 
 use super::protocol::rtde::{ClientEvent, ClientSession, RtdeValue};
+use super::tcp;
 use super::urscript;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
-use tokio::net::TcpStream;
 use tokio::net::tcp::OwnedWriteHalf;
 
 /// Output fields requested, in recipe order (the names [`ArmSample`] is decoded from).
@@ -67,11 +67,7 @@ fn err(cause: impl std::fmt::Display) -> String {
 impl UrClient {
     /// Connects, negotiates version 2, sets up the output and input recipes and starts streaming.
     pub async fn connect(addr: &str) -> Result<UrClient, String> {
-        let stream = tokio::time::timeout(SETUP_TIMEOUT, TcpStream::connect(addr))
-            .await
-            .map_err(|_| err(format!("{addr}: connect timed out")))?
-            .map_err(|e| err(format!("{addr}: {e}")))?;
-        stream.set_nodelay(true).map_err(err)?;
+        let stream = tcp::connect(addr, SETUP_TIMEOUT).await.map_err(err)?;
         let (mut reader, mut writer) = stream.into_split();
         let mut session = ClientSession::new();
         let mut buf = Vec::new();
@@ -212,10 +208,7 @@ pub fn decode_sample(values: &[RtdeValue]) -> Option<ArmSample> {
 
 /// Sends the motion program to the secondary interface (30002) and closes the connection.
 pub async fn upload_program(addr: &str, program: &str) -> Result<(), String> {
-    let mut stream = tokio::time::timeout(SETUP_TIMEOUT, TcpStream::connect(addr))
-        .await
-        .map_err(|_| format!("URScript {addr}: connect timed out"))?
-        .map_err(|e| format!("URScript {addr}: {e}"))?;
+    let mut stream = tcp::connect(addr, SETUP_TIMEOUT).await.map_err(|e| format!("URScript {e}"))?;
     stream.write_all(program.as_bytes()).await.map_err(|e| format!("URScript {addr}: {e}"))?;
     if !program.ends_with('\n') {
         stream.write_all(b"\n").await.map_err(|e| format!("URScript {addr}: {e}"))?;

@@ -4,10 +4,12 @@
 //!   virtual controller "runs" an uploaded program by doing what `follow.script` does (follow
 //!   `input_double_register_24..29` while `input_int_register_24` = 1, else hold); see
 //!   [`crate::cell::real::urscript`].
-//! - Dynamixel: MX-106 IDs 1 (growth) and 2 (twine) on a pseudo-terminal (its path in
-//!   [`ServeHandle::pty_path`]); Goal Position drives the twin's motors, Present Position reports them.
+//! - Dynamixel: two MX-106 at the scenario's `hardware.growth_id` and `hardware.twine_id` (1, 2 by
+//!   default) on a pseudo-terminal (its path in [`ServeHandle::pty_path`]); Goal Position drives
+//!   the twin's motors, Present Position reports them; Baud Rate reads `hardware.dxl_baud`.
 //! - HYPERION: commands on `command_port` (51971), one peak frame per twin tick on `stream_port`
-//!   (51972); FBG1 and FBG2 on channel 1.
+//!   (51972); FBG1 and FBG2 on channel `hardware.fbg.channel`, at the wavelengths the twin's
+//!   sensor model gives.
 //!
 //! Malformed input: RTDE and HYPERION connections are closed on a framing error (after the
 //! device's error reply where the protocol has one); the bus drops corrupt packets as a device does.
@@ -16,6 +18,8 @@
 mod net;
 mod twin;
 
+use crate::cell::real::HardwareConfig;
+use crate::cell::real::realtime::RealtimeOptions;
 use crate::run::scenario::PickPlaceScenario;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
@@ -39,10 +43,10 @@ pub struct ServeConfig {
     pub stream_port: u16,
     /// Twin tick [s]: the RTDE output and peak stream period. 1 ms = the si255's 1 kHz scan rate.
     pub period_s: f64,
-    /// SCHED_FIFO priority of the twin, bus and network threads (0: normal scheduling). The
-    /// virtual devices stand in for dedicated hardware; on a shared machine this keeps them from
-    /// waiting behind other processes. Needs root or CAP_SYS_NICE.
-    pub rt_priority: i32,
+    /// Scheduling of the twin, bus and network threads (default: normal). The virtual devices
+    /// stand in for dedicated hardware; on a shared machine a `SCHED_FIFO` priority keeps them from
+    /// waiting behind other processes, and a CPU of their own keeps them off the control thread's.
+    pub realtime: RealtimeOptions,
 }
 
 impl ServeConfig {
@@ -55,7 +59,7 @@ impl ServeConfig {
             command_port: 51971,
             stream_port: 51972,
             period_s: 1e-3,
-            rt_priority: 0,
+            realtime: RealtimeOptions::default(),
         }
     }
 
@@ -78,6 +82,8 @@ pub struct ServeHandle {
     pub addrs: [SocketAddr; 4],
     /// The devices' shared state (for tests comparing with the twin).
     pub state: Arc<std::sync::Mutex<DeviceState>>,
+    /// The motor IDs, bus speed and FBG channel served (the scenario's `[hardware]`).
+    pub hardware: HardwareConfig,
     stop: Arc<AtomicBool>,
     twin: Option<std::thread::JoinHandle<Result<(), String>>>,
     bus: Option<std::thread::JoinHandle<()>>,
@@ -121,24 +127,21 @@ impl Drop for ServeHandle {
 pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Result<ServeHandle> {
     anyhow::ensure!(config.period_s > 0.0 && config.period_s <= 0.01, "twin period must be in (0, 10 ms]");
     let stop = Arc::new(AtomicBool::new(false));
-    let (state, ticks) = twin::shared_state()?;
-    let rt = config.rt_priority;
-    if rt > 0 {
-        // Fail early and clearly rather than in each thread.
-        let probe = std::thread::spawn(move || crate::cell::real::latency::set_realtime_priority(rt));
-        probe.join().map_err(|_| anyhow::anyhow!("priority probe panicked"))??;
-    }
+    let hardware = scenario.hardware;
+    let (state, ticks) = twin::shared_state(&hardware)?;
+    let rt = config.realtime;
+    // Fail early and clearly rather than in each thread.
+    let probe = std::thread::spawn(move || rt.apply_to_current_thread());
+    probe.join().map_err(|_| anyhow::anyhow!("scheduling probe panicked"))??;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()
         .on_thread_start(move || {
-            if rt > 0 {
-                let _ = crate::cell::real::latency::set_realtime_priority(rt);
-            }
+            let _ = rt.apply_to_current_thread();
         })
         .build()?;
     let addrs = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe()))?;
     let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone(), rt)?;
     let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone(), rt)?;
-    Ok(ServeHandle { pty_path, addrs, state, stop, twin: Some(twin), bus: Some(bus), runtime: Some(runtime) })
+    Ok(ServeHandle { pty_path, addrs, state, hardware, stop, twin: Some(twin), bus: Some(bus), runtime: Some(runtime) })
 }

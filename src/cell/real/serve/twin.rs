@@ -1,11 +1,14 @@
 //! The twin thread (SimCell in real time) and the Dynamixel bus on a pseudo-terminal.
 
 use crate::cell::physics::SceneModel;
-use crate::cell::real::protocol::dynamixel::units::{rad_to_ticks, ticks_to_rad};
+use crate::cell::real::HardwareConfig;
+use crate::cell::real::protocol::dynamixel::control_table::addr;
+use crate::cell::real::protocol::dynamixel::units::{baud_rate_code, rad_to_ticks, ticks_to_rad};
 use crate::cell::real::protocol::dynamixel::{StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
 use crate::cell::real::protocol::rtde::state::RUNTIME_STATE_PLAYING;
 use crate::cell::real::protocol::rtde::{RobotOutputs, SharedInputs};
+use crate::cell::real::realtime::RealtimeOptions;
 use crate::cell::real::urscript::{ENABLE_REGISTER, FOLLOWING_REGISTER, TARGET_REGISTER};
 use crate::cell::sim::SimCell;
 use crate::hardware::{ARM_JOINTS, Cell, CellCommand, GroundTruth};
@@ -15,11 +18,6 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-
-/// Dynamixel ID of the growth motor on the virtual bus.
-pub const GROWTH_ID: u8 = 1;
-/// Dynamixel ID of the twine motor on the virtual bus.
-pub const TWINE_ID: u8 = 2;
 
 /// What the twin last computed (for tests and the serve printout).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,10 +67,23 @@ pub struct DeviceState {
     pub next_session: u64,
 }
 
-/// The shared state and the tick channel (the twin sends its tick count after each update).
-pub fn shared_state() -> anyhow::Result<(Arc<Mutex<DeviceState>>, tokio::sync::watch::Sender<u64>)> {
-    let bus = VirtualBus::with_ids(&[GROWTH_ID, TWINE_ID]).map_err(|e| anyhow::anyhow!("virtual bus: {e}"))?;
-    let interrogator = VirtualInterrogator::new(InterrogatorConfig::default())
+/// The shared state and the tick channel (the twin sends its tick count after each update): the
+/// motors at `hardware`'s IDs and bus speed, an interrogator with enough channels for its FBG channel.
+pub fn shared_state(
+    hardware: &HardwareConfig,
+) -> anyhow::Result<(Arc<Mutex<DeviceState>>, tokio::sync::watch::Sender<u64>)> {
+    let mut bus = VirtualBus::with_ids(&hardware.motor_ids()).map_err(|e| anyhow::anyhow!("virtual bus: {e}"))?;
+    let baud = baud_rate_code(hardware.dxl_baud)
+        .ok_or_else(|| anyhow::anyhow!("virtual bus: the MX-106 has no {} bit/s setting", hardware.dxl_baud))?;
+    for id in hardware.motor_ids() {
+        if let Some(t) = bus.table_mut(id) {
+            t.put(addr::BAUD_RATE, &[baud]);
+        }
+    }
+    // The si255 has 1, 4, 8 or 16 channels: the virtual one keeps its default 4 unless the FBG
+    // channel needs more.
+    let channel_count = [4, 8, 16].into_iter().find(|&n| n >= hardware.fbg.channel).unwrap_or(16) as u32;
+    let interrogator = VirtualInterrogator::new(InterrogatorConfig { channel_count, ..InterrogatorConfig::default() })
         .map_err(|e| anyhow::anyhow!("virtual interrogator: {e}"))?;
     let state = DeviceState {
         outputs: RobotOutputs::default(),
@@ -94,7 +105,7 @@ fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
 pub fn open_bus(
     state: Arc<Mutex<DeviceState>>,
     stop: Arc<AtomicBool>,
-    rt_priority: i32,
+    realtime: RealtimeOptions,
 ) -> anyhow::Result<(PathBuf, std::thread::JoinHandle<()>)> {
     use std::os::unix::io::AsRawFd;
     let (mut master, slave) = serial2::SerialPort::pair()?;
@@ -104,9 +115,7 @@ pub fn open_bus(
     let handle = std::thread::Builder::new().name("dxl-bus".into()).spawn(move || {
         // Keeping the slave open means reads on the master never fail with EIO between clients.
         let _slave = slave;
-        if rt_priority > 0 {
-            let _ = crate::cell::real::latency::set_realtime_priority(rt_priority);
-        }
+        let _ = realtime.apply_to_current_thread();
         let mut decoder = StreamDecoder::new();
         let mut chunk = [0u8; 1024];
         while !stop.load(Ordering::SeqCst) {
@@ -133,13 +142,13 @@ pub fn spawn(
     state: Arc<Mutex<DeviceState>>,
     ticks: tokio::sync::watch::Sender<u64>,
     stop: Arc<AtomicBool>,
-    rt_priority: i32,
+    realtime: RealtimeOptions,
 ) -> anyhow::Result<std::thread::JoinHandle<Result<(), String>>> {
     let model = SceneModel::build(&scenario.scene_spec())?;
+    let motors = scenario.hardware.motor_ids();
+    let channel = scenario.hardware.fbg.channel;
     let run = move || -> Result<(), String> {
-        if rt_priority > 0 {
-            let _ = crate::cell::real::latency::set_realtime_priority(rt_priority);
-        }
+        let _ = realtime.apply_to_current_thread();
         // Built here: the simulation's data stays on this thread.
         let mut cell = SimCell::for_scenario(&scenario, model);
         let e = |e: crate::hardware::CellError| e.to_string();
@@ -154,14 +163,11 @@ pub fn spawn(
         let mut previous_q = first.arm_q;
         {
             let mut s = lock(&state);
-            for (id, rad) in [(GROWTH_ID, first.growth_motor_rad), (TWINE_ID, first.twine_motor_rad)] {
+            for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
                 let ticks = rad_to_ticks(rad).map_err(|e| e.to_string())?;
                 if let Some(t) = s.bus.table_mut(id) {
                     t.set_present_position(ticks);
-                    t.put(
-                        crate::cell::real::protocol::dynamixel::control_table::addr::GOAL_POSITION,
-                        &ticks.to_le_bytes(),
-                    );
+                    t.put(addr::GOAL_POSITION, &ticks.to_le_bytes());
                 }
             }
             s.outputs.actual_q = first.arm_q;
@@ -180,7 +186,7 @@ pub fn spawn(
                 if following && targets.iter().all(|v| v.is_finite()) {
                     command.arm_q = targets;
                 }
-                for (id, slot) in [(GROWTH_ID, &mut command.growth_motor_rad), (TWINE_ID, &mut command.twine_motor_rad)]
+                for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
                 {
                     if let Some(t) = s.bus.table(id)
                         && t.torque_enabled()
@@ -206,7 +212,7 @@ pub fn spawn(
                 o.target_q = command.arm_q;
                 o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
                 previous_q = r.arm_q;
-                for (id, rad) in [(GROWTH_ID, r.growth_motor_rad), (TWINE_ID, r.twine_motor_rad)] {
+                for (id, rad) in motors.into_iter().zip([r.growth_motor_rad, r.twine_motor_rad]) {
                     if let (Some(t), Ok(ticks)) = (s.bus.table_mut(id), rad_to_ticks(rad)) {
                         t.set_present_position(ticks);
                     }
@@ -219,7 +225,9 @@ pub fn spawn(
                         timestamp_ns: nanos,
                         ..PeakHeader::default()
                     },
-                    channels: vec![vec![r.wavelengths.fbg1_nm, r.wavelengths.fbg2_nm]],
+                    channels: (1..=channel)
+                        .map(|c| if c == channel { vec![r.wavelengths.fbg1_nm, r.wavelengths.fbg2_nm] } else { vec![] })
+                        .collect(),
                 };
                 s.interrogator.set_peaks(frame).map_err(|e| e.to_string())?;
                 s.status = TwinStatus {

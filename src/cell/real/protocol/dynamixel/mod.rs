@@ -4,7 +4,7 @@
 //! - [`instruction`]: typed instruction and status packets.
 //! - [`control_table`]: the MX-106 (model 321) control table.
 //! - [`device`]: [`VirtualBus`], the device side `tendril serve` runs behind a pseudo-terminal.
-//! - [`units`]: ticks, velocity and current units to SI.
+//! - [`units`]: ticks, velocity and current units to SI; the bus speeds the MX-106 offers.
 //!
 //! For the client side on real hardware, the `dynamixel2` crate's `Bus` does the serial IO;
 //! these types are for the virtual device and for tests.

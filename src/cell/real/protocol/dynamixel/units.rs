@@ -49,6 +49,16 @@ pub fn amps_to_current_units(amps: f64) -> Result<i16, DxlError> {
     i16::try_from(units).map_err(|_| DxlError::Unrepresentable { quantity: "current (A)", value: amps })
 }
 
+/// The bus speeds an MX-106 (Protocol 2.0) offers [bit/s], indexed by the value of its Baud Rate
+/// register (address 8; ROBOTIS e-manual, MX-106(2.0) control table; 1 = 57 600 is the factory
+/// default).
+pub const BAUD_RATES: [u32; 8] = [9_600, 57_600, 115_200, 1_000_000, 2_000_000, 3_000_000, 4_000_000, 4_500_000];
+
+/// The Baud Rate register value for `bps`, if the MX-106 offers that speed.
+pub fn baud_rate_code(bps: u32) -> Option<u8> {
+    BAUD_RATES.iter().position(|&b| b == bps).map(|i| i as u8)
+}
+
 fn to_int(scaled: f64, quantity: &'static str, value: f64) -> Result<i32, DxlError> {
     let rounded = scaled.round();
     if rounded.is_finite() && rounded >= f64::from(i32::MIN) && rounded <= f64::from(i32::MAX) {
@@ -75,6 +85,13 @@ mod tests {
         assert_eq!(rad_s_to_velocity_units(45.0 * TAU / 60.0).unwrap(), 197);
         assert!((current_units_to_amps(1000) - 3.36).abs() < 1e-12);
         assert_eq!(amps_to_current_units(-3.36).unwrap(), -1000);
+    }
+
+    #[test]
+    fn baud_rates_map_to_their_register_values() {
+        assert_eq!(baud_rate_code(57_600), Some(1));
+        assert_eq!(baud_rate_code(1_000_000), Some(3));
+        assert_eq!(baud_rate_code(56_000), None);
     }
 
     #[test]

@@ -27,10 +27,15 @@ pub struct FbgWindows {
 }
 
 impl Default for FbgWindows {
-    /// ±5 nm around the nominal 1540/1550 nm Bragg wavelengths: far wider than the shifts the
-    /// sensor produces (tens of pm per newton, paper) and split at the midpoint 1545 nm.
+    /// Channel 1; FBG1 in [1535, 1547.8) nm, FBG2 in [1547.8, 1555) nm. FBG1 (1540 nm unloaded)
+    /// rises by up to 5.5 nm under force (the paper's 0 → 5482.78 pm span over its 4.69 N range)
+    /// and FBG2 (1550 nm) moves only with temperature (10.31 pm/°C), so the split sits midway
+    /// between FBG1 at full range (1545.5 nm) and FBG2: over 2 nm of margin either side, about
+    /// 95 °C of heating for FBG1 (24.29 pm/°C) and 210 °C of cooling for FBG2. (The midpoint of the
+    /// unloaded wavelengths, 1545 nm, would hand FBG1's peak to FBG2's window from about 4.2 N on,
+    /// inside the sensor's range.)
     fn default() -> Self {
-        Self { channel: 1, fbg1_min_nm: 1535.0, fbg1_max_nm: 1545.0, fbg2_min_nm: 1545.0, fbg2_max_nm: 1555.0 }
+        Self { channel: 1, fbg1_min_nm: 1535.0, fbg1_max_nm: 1547.8, fbg2_min_nm: 1547.8, fbg2_max_nm: 1555.0 }
     }
 }
 

@@ -1,0 +1,213 @@
+//! End to end with the two binaries, as a user runs them: `tendril serve scenarios/short-lift.toml`
+//! in one process, `tendril run scenarios/short-lift.toml --hardware real` against it in another
+//! (RTDE, URScript, HYPERION on loopback, the Dynamixel bus on the pty `serve` prints), and the
+//! simulated path `tendril run scenarios/short-lift.toml`. Both runs' `summary.json` must give
+//! the same outcome, and their `trace.csv` per-phase force medians and durations must agree
+//! within the tolerances of `common::phases`. About 16 s of wall time.
+//!
+//! Where the system allows it (root or CAP_SYS_NICE), both processes run their time-critical
+//! threads under SCHED_FIFO, as the docs advise for a real cell; elsewhere the test runs at normal
+//! priority and says so. Known limit: the grasp has a second contact configuration that the twin
+//! behind `serve` settles into when the commands reach it with other timings (median 0.54 N
+//! instead of 0.41 N, outside the 0.1 N tolerance). It was seen at normal priority during another
+//! session's build, and with busy loops started in the test's own session (which then share its
+//! CPU share), not with real-time priority under other sessions' load (busy loops on both cores).
+
+use std::io::{BufRead, BufReader};
+use std::net::TcpListener;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+mod common;
+use common::{LOOSE_WATCHDOG_S, SHORT_LIFT, one_at_a_time, phases};
+
+fn tendril() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tendril"));
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+/// A running `tendril serve`, killed when dropped (also when the test fails).
+struct Server {
+    child: Child,
+    /// Its standard output, line by line, as it comes.
+    lines: mpsc::Receiver<String>,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Server {
+    /// The Dynamixel pty path from the start-up printout, once everything listens.
+    fn pty_path(&self) -> Result<PathBuf, String> {
+        let deadline = Instant::now() + Duration::from_secs(30);
+        let mut seen = String::new();
+        while let Some(left) = deadline.checked_duration_since(Instant::now()) {
+            let Ok(line) = self.lines.recv_timeout(left) else { break };
+            seen += &line;
+            seen += "\n";
+            if let Some(rest) = line.trim_start().strip_prefix("Dynamixel ") {
+                let path = rest.split_whitespace().next().unwrap_or_default();
+                return Ok(PathBuf::from(path));
+            }
+        }
+        Err(format!("no Dynamixel line in the serve printout:\n{seen}"))
+    }
+}
+
+/// Four consecutive free ports on loopback (serve's `--port-base N` takes N..N+3), away from the
+/// fixed bases of the in-process tests (397xx) and the devices' own ports.
+fn free_port_base() -> u16 {
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+    let seed = u64::from(std::process::id()) ^ now.as_nanos() as u64;
+    for attempt in 0..200u64 {
+        let base = 41_000 + ((seed.wrapping_mul(2_654_435_761).wrapping_add(attempt * 97)) % 9_000) as u16 * 2;
+        let all_free = (base..base + 4).all(|p| TcpListener::bind(("127.0.0.1", p)).is_ok());
+        if all_free {
+            return base;
+        }
+    }
+    panic!("no four consecutive free ports found");
+}
+
+/// Starts `tendril serve SHORT_LIFT` on a free port base; a base taken in the meantime is retried.
+fn serve(extra: &[&str]) -> (Server, u16, PathBuf) {
+    let mut last_error = String::new();
+    for _ in 0..3 {
+        let base = free_port_base();
+        let mut child = tendril()
+            .args(["serve", SHORT_LIFT, "--port-base", &base.to_string()])
+            // A bound on its life even if this test process is killed before its Drop runs.
+            .args(["--seconds", "120"])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("tendril serve starts");
+        let stdout = child.stdout.take().expect("piped");
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                let _ = tx.send(line);
+            }
+        });
+        let mut server = Server { child, lines };
+        match server.pty_path() {
+            Ok(pty) => return (server, base, pty),
+            Err(e) => {
+                let _ = server.child.kill();
+                let mut stderr = String::new();
+                if let Some(mut s) = server.child.stderr.take() {
+                    let _ = std::io::Read::read_to_string(&mut s, &mut stderr);
+                }
+                last_error = format!("{e}\nstderr: {stderr}");
+            }
+        }
+    }
+    panic!("tendril serve did not start: {last_error}");
+}
+
+/// `--rt-priority` arguments for `serve` (the devices one level below) and `run`, if this process
+/// may use SCHED_FIFO; else none.
+fn realtime_args() -> (Vec<&'static str>, Vec<&'static str>) {
+    let probe = std::thread::spawn(|| {
+        let param = libc::sched_param { sched_priority: 1 };
+        // SAFETY: plain syscall on this short-lived probe thread with a valid parameter struct.
+        unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) == 0 }
+    });
+    if probe.join().unwrap_or(false) {
+        (vec!["--rt-priority", "19"], vec!["--rt-priority", "20"])
+    } else {
+        eprintln!("NOTE: no SCHED_FIFO here; serve and run at normal priority (a busy machine may fail this test)");
+        (vec![], vec![])
+    }
+}
+
+/// Runs `cmd` to completion, killing it after `limit`.
+fn run_with_limit(cmd: &mut Command, limit: Duration) -> Output {
+    let child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("tendril runs");
+    let pid = child.id();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(child.wait_with_output());
+    });
+    match rx.recv_timeout(limit) {
+        Ok(output) => output.expect("output collected"),
+        Err(_) => {
+            // SAFETY: plain kill(2) of the child we spawned, which has not been reaped yet.
+            unsafe { libc::kill(pid as libc::pid_t, libc::SIGKILL) };
+            panic!("{cmd:?} did not finish within {limit:?}");
+        }
+    }
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    let path = dir.join("summary.json");
+    serde_json::from_str(&std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))).unwrap()
+}
+
+fn describe(o: &Output) -> String {
+    format!("stdout:\n{}\nstderr:\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+#[test]
+fn tendril_run_real_against_tendril_serve_matches_the_simulated_run() {
+    let _turn = one_at_a_time();
+    let started = Instant::now();
+    let dir = tempfile::tempdir().unwrap();
+    let (sim_dir, real_dir) = (dir.path().join("sim"), dir.path().join("real"));
+
+    // The simulated path first, so it does not compete with the real-time one.
+    let sim = run_with_limit(tendril().args(["run", SHORT_LIFT, "--out"]).arg(&sim_dir), Duration::from_secs(60));
+    assert!(sim.status.success(), "simulated run failed\n{}", describe(&sim));
+
+    let (serve_rt, run_rt) = realtime_args();
+    let (server, base, pty) = serve(&serve_rt);
+    let watchdog_ms = (LOOSE_WATCHDOG_S * 1e3).to_string();
+    let sensor_samples = (LOOSE_WATCHDOG_S * 1e3).to_string(); // at the interrogator's 1 kHz
+    let real = run_with_limit(
+        tendril()
+            .args(["run", SHORT_LIFT, "--hardware", "real", "--port-base", &base.to_string(), "--dxl"])
+            .arg(&pty)
+            .args(["--sensor-stale-samples", &sensor_samples, "--arm-stale-ms", &watchdog_ms])
+            .args(["--dxl-timeout-ms", &watchdog_ms])
+            .args(&run_rt)
+            .arg("--out")
+            .arg(&real_dir),
+        Duration::from_secs(60),
+    );
+    drop(server);
+    assert!(real.status.success(), "real-path run failed\n{}", describe(&real));
+
+    let (s_sim, s_real) = (summary(&sim_dir), summary(&real_dir));
+    assert_eq!(s_sim["backend"], "mujoco");
+    assert_eq!(s_real["backend"], "real");
+    assert_eq!(s_real["error"], serde_json::Value::Null, "{s_real}");
+    assert_eq!(s_sim["outcome"], "held", "the short scenario holds on the twin: {s_sim}");
+    assert_eq!(s_real["outcome"], s_sim["outcome"], "real {s_real}");
+    phases::assert_phases_agree(
+        &phases::from_trace_csv(&sim_dir.join("trace.csv")),
+        &phases::from_trace_csv(&real_dir.join("trace.csv")),
+    );
+    eprintln!("wall time {:.1} s", started.elapsed().as_secs_f64());
+}
+
+#[test]
+fn serve_and_run_reject_a_bad_hardware_key_naming_file_and_key() {
+    for args in [
+        vec!["serve", SHORT_LIFT, "--seconds", "5", "--set", "hardware.twine_id=1"],
+        vec!["run", SHORT_LIFT, "--hardware", "real", "--dxl", "/dev/null", "--set", "hardware.twine_id=1"],
+    ] {
+        let out = run_with_limit(tendril().args(&args), Duration::from_secs(30));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} was accepted");
+        assert!(err.contains(SHORT_LIFT) && err.contains("`hardware.twine_id`"), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
