@@ -2,19 +2,9 @@
 //! and its settings checked like every other key.
 
 use serde_json::Value;
-use std::process::{Command, Output};
 
-fn tendril(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tendril"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::cli::{stderr, tendril};
 
 #[test]
 fn run_with_backend_rapier_names_it_in_the_summary() {

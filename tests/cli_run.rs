@@ -2,19 +2,10 @@
 //! finished lost.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn tendril(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tendril"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::cli::{stderr, tendril};
 
 /// A short pick-and-place (grasp 3 s, moves 1 s each) so the tests take a second, not a minute.
 const SHORT: [&str; 10] = [

@@ -1,7 +1,9 @@
-//! Helpers shared by the integration tests that run the twin in real time.
+//! Helpers shared by the integration tests: the binary as a user calls it ([`cli`]), and the
+//! real-time tests' turn-taking, scenario and phase comparison.
 // Each test crate compiles this module for the helpers it needs; the others would warn as unused.
 #![allow(dead_code)]
 
+pub mod cli;
 pub mod phases;
 
 use tendril::run::scenario::PickPlaceScenario;
