@@ -271,21 +271,18 @@ impl RapierWorld {
             }
             let [s0, s1, s2] = m.geom_size()[g];
             let local = pose(m.geom_pos()[g], m.geom_quat()[g]);
-            let builder = match m.geom_type()[g] {
-                _mjtGeomBase::mjGEOM_BOX => ColliderBuilder::cuboid(s0, s1, s2),
-                _mjtGeomBase::mjGEOM_SPHERE => ColliderBuilder::ball(s0),
-                _mjtGeomBase::mjGEOM_CAPSULE => ColliderBuilder::capsule_z(s1, s0),
-                // rapier's cylinder runs along y, MuJoCo's along z.
-                _mjtGeomBase::mjGEOM_CYLINDER => ColliderBuilder::cylinder(s1, s0)
-                    .position(local * Pose::from_rotation(Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2))),
-                _mjtGeomBase::mjGEOM_PLANE => ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Z)),
+            // rapier's cylinder runs along y, MuJoCo's along z: a quarter turn about x.
+            let along_z = Pose::from_rotation(Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2));
+            let (builder, local) = match m.geom_type()[g] {
+                _mjtGeomBase::mjGEOM_BOX => (ColliderBuilder::cuboid(s0, s1, s2), local),
+                _mjtGeomBase::mjGEOM_SPHERE => (ColliderBuilder::ball(s0), local),
+                _mjtGeomBase::mjGEOM_CAPSULE => (ColliderBuilder::capsule_z(s1, s0), local),
+                _mjtGeomBase::mjGEOM_CYLINDER => (ColliderBuilder::cylinder(s1, s0), local * along_z),
+                _mjtGeomBase::mjGEOM_PLANE => (ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Z)), local),
                 other => return Err(unsupported(format!("{other:?} geom `{}`", self.geom_names[g]))),
             };
-            let builder = match m.geom_type()[g] {
-                _mjtGeomBase::mjGEOM_CYLINDER => builder,
-                _ => builder.position(local),
-            };
             let collider = builder
+                .position(local)
                 .density(0.0)
                 .friction(m.geom_friction()[g][0])
                 .user_data(g as u128)
