@@ -90,7 +90,12 @@ impl SceneModel {
                 model.dof_armature_mut()[d] = KINEMATIC_ARM_ARMATURE;
             }
         }
-        Ok(Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids }))
+        let shared = Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids });
+        if spec.physics.backend == Backend::Rapier {
+            // Translate once now, so an element rapier cannot take is an error before any run starts.
+            super::rapier::RapierScene::new(shared.clone())?;
+        }
+        Ok(shared)
     }
 
     fn find_ids(m: &MjModel, spec: &SceneSpec) -> Result<Ids, PhysicsError> {
