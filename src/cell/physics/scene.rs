@@ -41,12 +41,12 @@ pub(crate) struct Ids {
     pub(crate) twine_qpos: usize,
     pub(crate) creep_qpos: usize,
     pub(crate) growth_act: usize,
+    pub(crate) twine_act: usize,
     /// Joints of the growth and twine outputs, the creep node and the arm.
     pub(crate) growth_joint: usize,
     pub(crate) twine_joint: usize,
     pub(crate) creep_joint: usize,
     pub(crate) arm_joint: [usize; 6],
-    pub(crate) twine_act: usize,
     pub(crate) arm_qpos: [usize; 6],
     pub(crate) arm_dof: [usize; 6],
     /// Servo actuators of the arm (dynamic mode only).
@@ -291,26 +291,6 @@ impl Scene {
         &self.data
     }
 
-    /// Advances one step; a diverging state is a [`PhysicsError::Diverged`] with the time.
-    fn step_once(&mut self) -> Result<(), PhysicsError> {
-        let t0 = self.data.time();
-        let dt = self.shared.spec.physics.timestep_s;
-        let set = self.drive.advance(t0, dt);
-        let ids = &self.shared.ids;
-        self.data.ctrl_mut()[ids.growth_act] = set.motors[0];
-        self.data.ctrl_mut()[ids.twine_act] = set.motors[1];
-        if ids.arm_act.is_none() {
-            // Prescribed motion: the joint velocity that takes the actual angles to the next commanded
-            // ones in this step (so nothing drifts). Writing qpos directly instead doubled the step time.
-            for k in 0..6 {
-                let actual = self.data.qpos()[ids.arm_qpos[k]];
-                self.data.qvel_mut()[ids.arm_dof[k]] = (set.arm_q[k] - actual) / dt;
-            }
-        }
-        self.data.step();
-        self.check(t0 + dt)
-    }
-
     fn check(&mut self, time_s: f64) -> Result<(), PhysicsError> {
         let diverged = |cause| Err(PhysicsError::Diverged { time_s, cause });
         // Warnings first: on a bad acceleration MuJoCo resets the state, so the NaN is gone by now.
@@ -373,51 +353,6 @@ impl Scene {
         self.data.sensordata()[self.shared.ids.pad_touch_adr]
     }
 
-    fn mujoco_readout(&self) -> PhysicsReadout {
-        let ids = &self.shared.ids;
-        let qpos = self.data.qpos();
-        let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
-        let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
-        let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
-        let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
-        let hq = self.data.xquat()[ids.hand_body];
-        let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
-        let hand = Isometry3::from_parts(hand_p.into(), hand_rot);
-        let mut r = PhysicsReadout {
-            time_s: self.data.time(),
-            pad_force_n,
-            grip_force_n,
-            palm_force_n,
-            grip_contacts,
-            touching: grip_contacts > 0,
-            hand_pos_m: hand_p.into(),
-            growth_m: qpos[ids.growth_qpos],
-            twine_m: qpos[ids.twine_qpos],
-            twine_setpoint_m: self.drive.twine_setpoint_m(),
-            creep_m: qpos[ids.creep_qpos],
-            tendon_tension_n: self.tendon_tension_n(),
-            arm_q: match ids.arm_act {
-                Some(_) => ids.arm_qpos.map(|a| qpos[a]),
-                None => self.drive.arm_q(),
-            },
-            ..PhysicsReadout::default()
-        };
-        if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {
-            r.object_pos_m = self.data.xpos()[body];
-            r.object_quat = self.data.xquat()[body];
-            let p = Vector3::from(self.data.geom_xpos()[grip]);
-            let vo = self.data.object_velocity(_mjtObjBase::mjOBJ_GEOM, grip, false);
-            let vh = self.data.object_velocity(_mjtObjBase::mjOBJ_BODY, ids.hand_body, false);
-            let v_obj = Vector3::new(vo[3], vo[4], vo[5]);
-            let w_hand = Vector3::new(vh[0], vh[1], vh[2]);
-            let in_hand = grip_in_hand(&hand, Vector3::new(vh[3], vh[4], vh[5]), w_hand, p, v_obj);
-            r.object_vel_m_s = v_obj.into();
-            r.slip_speed_m_s = in_hand.slip_speed_m_s;
-            r.object_in_hand_m = in_hand.position_m;
-        }
-        r
-    }
-
     /// Tension of the tendon path [N]: both standard-linear-solid branches (zero when slack).
     pub fn tendon_tension_n(&self) -> f64 {
         let ids = &self.shared.ids;
@@ -472,11 +407,67 @@ impl Physics for Scene {
     }
 
     fn step(&mut self) -> Result<(), PhysicsError> {
-        self.step_once()
+        let t0 = self.data.time();
+        let dt = self.shared.spec.physics.timestep_s;
+        let set = self.drive.advance(t0, dt);
+        let ids = &self.shared.ids;
+        self.data.ctrl_mut()[ids.growth_act] = set.motors[0];
+        self.data.ctrl_mut()[ids.twine_act] = set.motors[1];
+        if ids.arm_act.is_none() {
+            // Prescribed motion: the joint velocity that takes the actual angles to the next commanded
+            // ones in this step (so nothing drifts). Writing qpos directly instead doubled the step time.
+            for k in 0..6 {
+                let actual = self.data.qpos()[ids.arm_qpos[k]];
+                self.data.qvel_mut()[ids.arm_dof[k]] = (set.arm_q[k] - actual) / dt;
+            }
+        }
+        self.data.step();
+        self.check(t0 + dt)
     }
 
     fn readout(&self) -> PhysicsReadout {
-        self.mujoco_readout()
+        let ids = &self.shared.ids;
+        let qpos = self.data.qpos();
+        let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
+        let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
+        let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
+        let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
+        let hq = self.data.xquat()[ids.hand_body];
+        let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
+        let hand = Isometry3::from_parts(hand_p.into(), hand_rot);
+        let mut r = PhysicsReadout {
+            time_s: self.data.time(),
+            pad_force_n,
+            grip_force_n,
+            palm_force_n,
+            grip_contacts,
+            touching: grip_contacts > 0,
+            hand_pos_m: hand_p.into(),
+            growth_m: qpos[ids.growth_qpos],
+            twine_m: qpos[ids.twine_qpos],
+            twine_setpoint_m: self.drive.twine_setpoint_m(),
+            creep_m: qpos[ids.creep_qpos],
+            tendon_tension_n: self.tendon_tension_n(),
+            arm_q: match ids.arm_act {
+                Some(_) => ids.arm_qpos.map(|a| qpos[a]),
+                None => self.drive.arm_q(),
+            },
+            ..PhysicsReadout::default()
+        };
+        if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {
+            r.object_pos_m = self.data.xpos()[body];
+            r.object_quat = self.data.xquat()[body];
+            let p = Vector3::from(self.data.geom_xpos()[grip]);
+            let vo = self.data.object_velocity(_mjtObjBase::mjOBJ_GEOM, grip, false);
+            let vh = self.data.object_velocity(_mjtObjBase::mjOBJ_BODY, ids.hand_body, false);
+            let v_obj = Vector3::new(vo[3], vo[4], vo[5]);
+            let w_hand = Vector3::new(vh[0], vh[1], vh[2]);
+            let in_hand = grip_in_hand(&hand, Vector3::new(vh[3], vh[4], vh[5]), w_hand, p, v_obj);
+            r.object_vel_m_s = v_obj.into();
+            r.slip_speed_m_s = in_hand.slip_speed_m_s;
+            r.object_in_hand_m = in_hand.position_m;
+        }
+        r
     }
 }
 

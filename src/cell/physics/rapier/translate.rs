@@ -35,12 +35,12 @@ use rapier3d_f64::na::Unit;
 use rapier3d_f64::prelude::*;
 
 /// A MuJoCo vector as rapier's.
-pub fn vec3(a: [f64; 3]) -> Vector {
+fn vec3(a: [f64; 3]) -> Vector {
     Vector::new(a[0], a[1], a[2])
 }
 
 /// A MuJoCo quaternion (w, x, y, z) as rapier's rotation.
-pub fn rot3(q: [f64; 4]) -> Rotation {
+fn rot3(q: [f64; 4]) -> Rotation {
     Rotation::from_xyzw(q[1], q[2], q[3], q[0]).normalize()
 }
 
@@ -153,12 +153,12 @@ impl RapierWorld {
                     .local_frame1(relative * frame2)
                     .local_frame2(frame2)
                     .contacts_enabled(true);
-                    if m.jnt_limited()[j] && !carried[parent] && !prescribed.contains(&j) {
+                    let kinematic = prescribed.contains(&j);
+                    carried[b] = kinematic || carried[parent];
+                    if m.jnt_limited()[j] && !carried[b] {
                         joint = joint.limits(kind.axis(), m.jnt_range()[j]);
                     }
                     let handle = world.insert_body(dynamic());
-                    let kinematic = prescribed.contains(&j);
-                    carried[b] = kinematic || carried[parent];
                     let inserted = if kinematic {
                         world.multibody_joints.insert_kinematic(bodies[parent], handle, joint.build(), true)
                     } else {
@@ -203,6 +203,7 @@ impl RapierWorld {
             ctrl: vec![0.0; m.ffi().nu as usize],
             geom_names: (0..ngeom).map(|g| name(_mjtObjBase::mjOBJ_GEOM, g)).collect(),
             time_s: 0.0,
+            generalized: Vec::new(),
             max_penetration_m: physics.max_penetration_m,
             max_kinetic_energy_j: physics.max_kinetic_energy_j,
         };

@@ -60,7 +60,7 @@ pub(super) struct FixedTendon {
 
 #[derive(Debug, Clone, Copy)]
 pub(super) enum ActuatorKind {
-    /// Position servo: force = kp (ctrl - q) - kv qdot, as a joint motor.
+    /// Position servo: force = kp (ctrl - q) - kv qdot, as the joint's implicit spring and damping.
     Position { kp: f64, kv: f64 },
     /// Force actuator: generalized force = gain x ctrl.
     Motor { gain: f64 },
@@ -91,6 +91,8 @@ pub struct RapierWorld {
     pub(super) ctrl: Vec<f64>,
     pub(super) geom_names: Vec<String>,
     pub(super) time_s: f64,
+    /// Generalized force per joint for the step being prepared (kept to reuse its allocation).
+    pub(super) generalized: Vec<f64>,
     pub(super) max_penetration_m: f64,
     pub(super) max_kinetic_energy_j: f64,
 }
@@ -111,8 +113,13 @@ impl RapierWorld {
         self.ctrl[i] = value;
     }
 
+    /// Joint `j` as a multibody link (`None`: a free joint or no such joint).
+    fn joint_link(&self, j: usize) -> Option<&JointLink> {
+        self.joints.get(j)?.as_ref()
+    }
+
     fn link(&self, j: usize) -> Option<(&JointLink, &Multibody, usize)> {
-        let link = self.joints.get(j)?.as_ref()?;
+        let link = self.joint_link(j)?;
         let (mb, id) = self.world.multibody_joints.get(link.handle)?;
         Some((link, mb, id))
     }
@@ -131,8 +138,8 @@ impl RapierWorld {
 
     /// Sets the velocity of prescribed joint `j` for the next step.
     pub fn set_joint_velocity(&mut self, j: usize, v: f64) {
-        let Some(link) = self.joints.get(j).and_then(|l| l.as_ref()) else { return };
-        if let Some((mb, id)) = self.world.multibody_joints.get_mut(link.handle)
+        let Some(handle) = self.joint_link(j).map(|l| l.handle) else { return };
+        if let Some((mb, id)) = self.world.multibody_joints.get_mut(handle)
             && let Some(a) = mb.link(id).map(|l| l.assembly_id())
         {
             mb.generalized_velocity_mut()[a] = v;
@@ -142,9 +149,9 @@ impl RapierWorld {
     /// Moves prescribed joint `j` to position `q` at once (start poses), with everything it carries.
     pub fn place_joint(&mut self, j: usize, q: f64) {
         let current = self.joint_position(j);
-        let Some(link) = self.joints.get(j).and_then(|l| l.as_ref()) else { return };
+        let Some(handle) = self.joint_link(j).map(|l| l.handle) else { return };
         let bodies = &mut self.world.bodies;
-        if let Some((mb, id)) = self.world.multibody_joints.get_mut(link.handle)
+        if let Some((mb, id)) = self.world.multibody_joints.get_mut(handle)
             && let Some(a) = mb.link(id).map(|l| l.assembly_id())
         {
             let mut disp = DVector::zeros(mb.ndofs());
@@ -222,7 +229,9 @@ impl RapierWorld {
 
     /// Advances one step: actuators and tendons, then rapier's step, then the divergence checks.
     pub fn step(&mut self) -> Result<(), PhysicsError> {
-        let mut generalized = vec![0.0; self.joints.len()];
+        let mut generalized = std::mem::take(&mut self.generalized);
+        generalized.clear();
+        generalized.resize(self.joints.len(), 0.0);
         for t in &self.tendons {
             let f = self.tendon_force(t);
             for &(j, coef) in &t.terms {
@@ -256,6 +265,7 @@ impl RapierWorld {
                 self.apply_generalized(j, *f);
             }
         }
+        self.generalized = generalized;
         self.world.step_with_events(&self.rules, &());
         self.time_s += self.timestep();
         self.check()
@@ -266,7 +276,7 @@ impl RapierWorld {
     /// servo pushes with at most `force_max`.
     fn set_servo(&mut self, j: usize, target: f64, kp: f64, force_max: f64) {
         let q = self.joint_position(j);
-        let Some(link) = self.joints.get(j).and_then(|l| l.as_ref()) else { return };
+        let Some(link) = self.joint_link(j) else { return };
         let reach = force_max / kp;
         let target = target.clamp(q - reach, q + reach) - link.qpos0;
         let k = link.stiffness + kp;
@@ -282,7 +292,7 @@ impl RapierWorld {
     /// Applies generalized force `f` on joint `j` as a wrench pair: on the child body and, opposite,
     /// on the parent at the same point, so no other joint feels it.
     fn apply_generalized(&mut self, j: usize, f: f64) {
-        let Some(link) = self.joints.get(j).and_then(|l| l.as_ref()).cloned() else { return };
+        let Some(link) = self.joints.get(j).and_then(Option::as_ref) else { return };
         let child = *self.world.bodies[link.body].position();
         let axis = child.rotation * link.axis_local;
         let anchor = child * link.anchor_local;
