@@ -4,8 +4,9 @@
 //! within the tolerances of `common::phases`. `tests/serve_run_e2e.rs` does the same with the two
 //! binaries; here the twin's ground truth is at hand, and the devices' state after a stop.
 
-use tendril::cell::real::RealCellConfig;
-use tendril::cell::real::serve::{ServeConfig, start};
+use tendril::cell::real::serve::{ServeConfig, ServeHandle, start};
+use tendril::cell::real::{RealCell, RealCellConfig};
+use tendril::hardware::Cell;
 use tendril::run::execute::run_on_twin;
 use tendril::run::real::run_on_real;
 use tendril::run::runner::Outcome;
@@ -99,13 +100,7 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
 #[test]
 fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
     let _turn = one_at_a_time();
-    use tendril::hardware::Cell;
-    let scenario = short_lift(&[]);
-    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39730)).unwrap();
-    let config = RealCellConfig::for_virtual_devices(&serve);
-    let mut cell = tendril::cell::real::RealCell::new(config);
-    cell.configure().unwrap();
-    cell.activate().unwrap();
+    let (serve, mut cell) = active_cell(39730, |_| {});
     let s = cell.read().unwrap();
     assert!(s.wavelengths.fbg1_nm > 1500.0);
     // Stop the whole virtual cell: the stream goes silent.
@@ -118,16 +113,40 @@ fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
 }
 
 #[test]
+fn a_silent_gripper_bus_neither_holds_up_the_tick_nor_goes_unnoticed() {
+    let _turn = one_at_a_time();
+    use std::time::Duration;
+    // Only the motors' watchdog may fire while the devices are silenced.
+    let (serve, mut cell) = active_cell(39790, |config| {
+        config.sensor_stale_samples = 1.0 / config.sensor_period_s;
+        config.arm_stale_s = 1.0;
+        config.dxl_reply_timeout = Duration::from_millis(250);
+    });
+    let before = cell.read().unwrap();
+    // Holding the virtual devices' state silences the bus (and pauses the twin) until released.
+    let silenced = serve.state.lock().unwrap();
+    cell.wait_until(0.01).unwrap();
+    std::thread::sleep(Duration::from_millis(20));
+    // The tick goes on with the positions it has (a read waiting on the bus would wait for this
+    // thread to release the devices: until the reply timeout).
+    let during = cell.read().unwrap();
+    assert_eq!(during.twine_motor_rad, before.twine_motor_rad);
+    assert_eq!(cell.motor_stats().behind, 1, "{:?}", cell.motor_stats());
+    // Past the reply timeout the motors' watchdog stops the cell.
+    std::thread::sleep(Duration::from_millis(300));
+    let err = cell.read().unwrap_err().to_string();
+    drop(silenced);
+    assert!(err.contains("MX-106"), "{err}");
+    assert!(err.contains("did not answer") || err.contains("watchdog"), "{err}");
+    cell.deactivate().unwrap();
+    serve.stop().unwrap();
+}
+
+#[test]
 fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
     let _turn = one_at_a_time();
-    use tendril::hardware::{Cell, CellCommand};
-    let scenario = short_lift(&[]);
-    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39760)).unwrap();
-    let mut config = RealCellConfig::for_virtual_devices(&serve);
-    loose_watchdog(&mut config);
-    let mut cell = tendril::cell::real::RealCell::new(config);
-    cell.configure().unwrap();
-    cell.activate().unwrap();
+    use tendril::hardware::CellCommand;
+    let (serve, mut cell) = active_cell(39760, loose_watchdog);
     // Wind the twine motor for half a second, then stop as Ctrl-C does.
     for k in 1..=50 {
         let s = cell.read().unwrap();
@@ -165,9 +184,9 @@ fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on
 #[test]
 fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
     let _turn = one_at_a_time();
+    use tendril::cell::real::HardwareConfig;
     use tendril::cell::real::protocol::dynamixel::control_table::addr;
-    use tendril::cell::real::{HardwareConfig, RealCell};
-    use tendril::hardware::{Cell, CellCommand};
+    use tendril::hardware::CellCommand;
     let scenario = short_lift(&[
         "hardware.growth_id=11",
         "hardware.twine_id=12",
@@ -203,4 +222,16 @@ fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
     let err = RealCell::new(config).configure().unwrap_err().to_string();
     assert!(err.contains("ID 1 did not answer"), "{err}");
     serve.stop().unwrap();
+}
+
+/// Virtual devices serving the short lift on ports `port_base`.., and a real cell on them, its
+/// configuration adjusted by `tune`, configured and activated.
+fn active_cell(port_base: u16, tune: impl FnOnce(&mut RealCellConfig)) -> (ServeHandle, RealCell) {
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(port_base)).unwrap();
+    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    tune(&mut config);
+    let mut cell = RealCell::new(config);
+    cell.configure().unwrap();
+    cell.activate().unwrap();
+    (serve, cell)
 }

@@ -76,12 +76,16 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     control.apply_to_current_thread()?;
     let mut cell = RealCell::new(config);
     let r = measure(&mut cell, a.rate_hz, a.seconds)?;
+    let motors = cell.motor_stats();
     drop(cell);
     serve.stop().map_err(|e| anyhow::anyhow!("twin: {e}"))?;
     emit(&format!(
-        "real path vs virtual devices, {label}: {}; read+write alone p99 {:.3} ms\n",
+        "real path vs virtual devices, {label}: {}; read+write alone p99 {:.3} ms; \
+         motor positions a tick late in {} of {} reads\n",
         describe(&r),
-        r.work_p99_s * 1e3
+        r.work_p99_s * 1e3,
+        motors.behind,
+        motors.reads,
     ));
     Ok(ExitCode::SUCCESS)
 }

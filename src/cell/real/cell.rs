@@ -1,26 +1,29 @@
 //! [`RealCell`]: the UR5e, the two MX-106 servos and the HYPERION behind the [`Cell`] trait.
 //!
-//! IO: a small tokio runtime owns the RTDE and peak-stream reader tasks; the control thread reads
-//! their latest samples, writes RTDE inputs (async, driven with `block_on`) and talks to the
-//! Dynamixel bus directly (blocking, bounded). Time is the wall clock since [`Cell::activate`];
-//! [`Cell::wait_until`] puts the motors' position request on the bus [`PREFETCH_BEFORE_TICK`] early,
-//! then sleeps to just before the deadline and spins the rest ([`super::realtime::sleep_until`]),
-//! with the activating thread's timer slack at 1 ns.
+//! IO: no tick waits on a device. A small tokio runtime owns the RTDE and peak-stream reader tasks,
+//! whose latest samples the control thread reads; RTDE inputs are written without blocking
+//! ([`UrClient::try_send`]); the Dynamixel bus is driven by an IO thread while the cell is active
+//! ([`GripperLink`]), directly at set-up and stop. Time is the wall clock since [`Cell::activate`];
+//! [`Cell::wait_until`] asks for the motors' positions [`PREFETCH_BEFORE_TICK`] early, then sleeps
+//! to just before the deadline and spins the rest ([`super::realtime::sleep_until`]), with the
+//! activating thread's timer slack at 1 ns.
 //!
 //! Safety on our side (the controller's and the servos' own limits still apply):
-//! - watchdog: a sensor sample older than `sensor_stale_samples` interrogator periods, or an arm
-//!   sample older than `arm_stale_s`, the arm leaving running/normal mode, or the follow program
-//!   no longer playing (stopped on the pendant), fails `read`; the
-//!   runner then calls [`Cell::deactivate`];
+//! - watchdog: a sensor sample older than `sensor_stale_samples` interrogator periods, an arm
+//!   sample older than `arm_stale_s`, motor positions older than `dxl_reply_timeout`, the arm
+//!   leaving running/normal mode, or the follow program no longer playing (stopped on the
+//!   pendant), fails `read`; the runner then calls [`Cell::deactivate`];
 //! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way;
-//! - `deactivate` (every exit path): enable flag 0 → the URScript program `stopj`s the arm;
-//!   gripper goal = present position with torque ON (holds the object); see [`super::dxl`].
+//! - `deactivate` (every exit path): enable flag 0 → the URScript program `stopj`s the arm; the
+//!   bus's IO thread stops and the gripper's goal = present position with torque ON (holds the
+//!   object); see [`super::dxl`].
 //!
 //! Joint speed/acceleration limits and the force ceiling are the [`super::limits::LimitedCell`]
 //! decorator's job.
 
 use super::config::HardwareConfig;
 use super::dxl::GripperBus;
+use super::dxl_link::{GripperLink, LinkStats};
 use super::interrogator::{self, PeakFeed};
 use super::protocol::rtde::state::{ROBOT_MODE_RUNNING, RUNTIME_STATE_PLAYING, SAFETY_MODE_NORMAL};
 use super::serve::ServeHandle;
@@ -32,10 +35,11 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// How long before a tick [`Cell::wait_until`] asks the motors for their positions. Over the
-/// virtual devices' pty the round trip takes about 0.1 ms, so it is over before the tick on all
-/// but a stalled machine's ticks; on a real bus (wire time, the motors' return delay, a USB
-/// adapter's latency timer) it takes a millisecond or more, of which this hides half. Short
-/// against the motors' motion: at the MX-106's 45 rpm no-load speed, 0.14° in 0.5 ms.
+/// virtual devices' pty the round trip takes about 0.1 ms, so the answer is there by the tick
+/// unless the machine stalls (then the tick uses the previous tick's, see [`GripperLink`]); on a
+/// real bus (wire time, the motors' return delay, a USB adapter's latency timer) it takes a
+/// millisecond or more, of which this hides half. Short against the motors' motion: at the
+/// MX-106's 45 rpm no-load speed, 0.14° in 0.5 ms.
 pub const PREFETCH_BEFORE_TICK: Duration = Duration::from_micros(500);
 
 /// Where the devices are and how strict the watchdog is.
@@ -65,7 +69,8 @@ pub struct RealCellConfig {
     pub sensor_stale_samples: f64,
     /// Watchdog on the RTDE stream [s]: 5 periods at 500 Hz.
     pub arm_stale_s: f64,
-    /// Longest wait for a motor's reply ([`super::dxl::REPLY_TIMEOUT`], 50 ms).
+    /// Longest wait for a motor's reply ([`super::dxl::REPLY_TIMEOUT`], 50 ms), and the watchdog
+    /// on the motors' positions: older than this, the cell stops.
     pub dxl_reply_timeout: Duration,
     /// Send the follow program to the controller at configure.
     pub upload_program: bool,
@@ -114,9 +119,17 @@ impl RealCellConfig {
     }
 }
 
+/// The gripper bus: driven directly while the cell is inactive, by its IO thread while active.
+enum Gripper {
+    Direct(GripperBus),
+    Linked(GripperLink),
+    /// The IO thread could not be started or panicked; the bus went with it.
+    Lost,
+}
+
 struct Devices {
     ur: UrClient,
-    gripper: GripperBus,
+    gripper: Gripper,
     peaks: Arc<Mutex<PeakFeed>>,
     peak_task: tokio::task::JoinHandle<()>,
 }
@@ -130,6 +143,8 @@ pub struct RealCell {
     started: Instant,
     stop: Arc<AtomicBool>,
     last_arm_q: Option<[f64; ARM_JOINTS]>,
+    /// Freshness of the motor positions of activations already ended.
+    motor_stats: LinkStats,
     /// Serial number and channel count read at configure.
     pub identity: Option<interrogator::Identity>,
 }
@@ -149,6 +164,7 @@ impl RealCell {
             started: Instant::now(),
             stop: Arc::new(AtomicBool::new(false)),
             last_arm_q: None,
+            motor_stats: LinkStats::default(),
             identity: None,
         }
     }
@@ -156,6 +172,15 @@ impl RealCell {
     /// A flag that makes the next `read` fail (an operator stop); shared with signal handlers.
     pub fn stop_flag(&self) -> Arc<AtomicBool> {
         self.stop.clone()
+    }
+
+    /// How fresh the motor positions the ticks used were, over every activation so far.
+    pub fn motor_stats(&self) -> LinkStats {
+        let mut stats = self.motor_stats;
+        if let Some(Devices { gripper: Gripper::Linked(link), .. }) = &self.devices {
+            stats += link.stats();
+        }
+        stats
     }
 
     fn parts(&mut self) -> (&tokio::runtime::Runtime, &mut Devices) {
@@ -199,7 +224,7 @@ impl RealCell {
             .map_err(CellError::Configure)?;
         self.identity = Some(identity);
         self.runtime = Some(runtime);
-        self.devices = Some(Devices { ur, gripper, peaks, peak_task });
+        self.devices = Some(Devices { ur, gripper: Gripper::Direct(gripper), peaks, peak_task });
         // The first samples of both streams must arrive before the cell counts as configured.
         let deadline = Instant::now() + Duration::from_secs(2);
         loop {
@@ -242,8 +267,13 @@ impl Cell for RealCell {
 
     fn activate(&mut self) -> Result<(), CellError> {
         require_state(self.lifecycle, Lifecycle::Inactive, "activate")?;
-        // The thread that activates is the one that runs the ticks: its sleeps should end on time.
+        // The thread that activates is the one that runs the ticks: its sleeps should end on time,
+        // and the bus's IO thread, started from it, runs at its priority on its CPU.
         super::realtime::set_timer_slack_ns(1);
+        let (_, d) = self.parts();
+        let linked;
+        (d.gripper, linked) = std::mem::replace(&mut d.gripper, Gripper::Lost).start_link();
+        linked.map_err(|e| device("MX-106", e))?;
         self.started = Instant::now();
         self.lifecycle = Lifecycle::Active;
         Ok(())
@@ -258,8 +288,10 @@ impl Cell for RealCell {
         let (rt, d) = self.parts();
         // Both stops are attempted even if the first fails.
         let arm = rt.block_on(d.ur.send(q, false)).map_err(|e| device("UR5e", e));
-        let hand = d.gripper.hold().map_err(|e| device("MX-106", e));
-        arm.and(hand)
+        let (hand, stats);
+        (d.gripper, stats, hand) = std::mem::replace(&mut d.gripper, Gripper::Lost).stop_link_and_hold();
+        self.motor_stats += stats;
+        arm.and(hand.map_err(|e| device("MX-106", e)))
     }
 
     fn read(&mut self) -> Result<CellState, CellError> {
@@ -271,6 +303,7 @@ impl Cell for RealCell {
         let sensor_stale = Duration::from_secs_f64(self.config.sensor_period_s * self.config.sensor_stale_samples);
         let arm_stale = Duration::from_secs_f64(self.config.arm_stale_s);
         let upload = self.config.upload_program;
+        let motors_stale = self.config.dxl_reply_timeout;
         let (_, d) = self.parts();
         let (arm, age) = d.ur.latest().map_err(|e| device("UR5e", e))?.ok_or_else(|| device("UR5e", "no data"))?;
         if age > arm_stale {
@@ -297,7 +330,15 @@ impl Cell for RealCell {
             }
             w
         };
-        let [growth, twine] = d.gripper.present_rad().map_err(|e| device("MX-106", e))?;
+        let motors = d.gripper.link()?.latest().map_err(|e| device("MX-106", e))?;
+        let age = motors.requested_at.elapsed();
+        if age > motors_stale {
+            return Err(device(
+                "MX-106",
+                format!("watchdog: last motor positions {:.1} ms old", age.as_secs_f64() * 1e3),
+            ));
+        }
+        let [growth, twine] = motors.rad;
         self.last_arm_q = Some(arm.q);
         Ok(CellState { time_s, arm_q: arm.q, growth_motor_rad: growth, twine_motor_rad: twine, wavelengths })
     }
@@ -307,9 +348,10 @@ impl Cell for RealCell {
         if c.arm_q.iter().chain([&c.growth_motor_rad, &c.twine_motor_rad]).any(|v| !v.is_finite()) {
             return Err(device("command", format!("non-finite target {c:?}")));
         }
-        let (rt, d) = self.parts();
-        rt.block_on(d.ur.send(c.arm_q, true)).map_err(|e| device("UR5e", e))?;
-        d.gripper.set_goal_rad([c.growth_motor_rad, c.twine_motor_rad]).map_err(|e| device("MX-106", e))
+        let (_, d) = self.parts();
+        d.ur.try_send(c.arm_q, true).map_err(|e| device("UR5e", e))?;
+        d.gripper.link()?.set_goal_rad([c.growth_motor_rad, c.twine_motor_rad]);
+        Ok(())
     }
 
     fn wait_until(&mut self, time_s: f64) -> Result<(), CellError> {
@@ -324,9 +366,58 @@ impl Cell for RealCell {
             }
         }
         let (_, d) = self.parts();
-        d.gripper.request_present().map_err(|e| device("MX-106", e))?;
+        d.gripper.link()?.request_present();
         super::realtime::sleep_until(deadline);
         Ok(())
+    }
+}
+
+/// Why the gripper can no longer be driven.
+const BUS_LOST: &str = "bus lost with its IO thread";
+
+impl Gripper {
+    /// Hands the bus to its IO thread, with positions read now as the first sample (the bus stays
+    /// direct if they cannot be read).
+    fn start_link(self) -> (Gripper, Result<(), String>) {
+        match self {
+            Gripper::Direct(mut bus) => match bus.present_rad() {
+                Ok(first) => match GripperLink::start(bus, first) {
+                    Ok(link) => (Gripper::Linked(link), Ok(())),
+                    Err(why) => (Gripper::Lost, Err(why)),
+                },
+                Err(why) => (Gripper::Direct(bus), Err(why)),
+            },
+            linked @ Gripper::Linked(_) => (linked, Ok(())),
+            Gripper::Lost => (Gripper::Lost, Err(BUS_LOST.into())),
+        }
+    }
+
+    /// Stops the IO thread and puts the motors in their safe state directly; also returns how
+    /// fresh the positions the ticks used were.
+    fn stop_link_and_hold(self) -> (Gripper, LinkStats, Result<(), String>) {
+        let (bus, stats) = match self {
+            Gripper::Linked(link) => {
+                let stats = link.stats();
+                (link.stop(), stats)
+            }
+            Gripper::Direct(bus) => (Ok(bus), LinkStats::default()),
+            Gripper::Lost => (Err(BUS_LOST.into()), LinkStats::default()),
+        };
+        match bus {
+            Ok(mut bus) => {
+                let held = bus.hold();
+                (Gripper::Direct(bus), stats, held)
+            }
+            Err(why) => (Gripper::Lost, stats, Err(why)),
+        }
+    }
+
+    /// The IO thread's end of the bus (the cell is active).
+    fn link(&self) -> Result<&GripperLink, CellError> {
+        match self {
+            Gripper::Linked(link) => Ok(link),
+            _ => Err(device("MX-106", "bus not driven while the cell is inactive")),
+        }
     }
 }
 

@@ -3,9 +3,10 @@
 //! Client decision (the `dynamixel2` 0.9 stuffing bug on `FF FF FF FD`, see the protocol module):
 //! we drive the bus with this project's own codec ([`InstructionPacket`], [`StreamDecoder`]) on a
 //! `serial2` port directly, so stuffing is the codec's (tested byte for byte against the manual)
-//! and no retry is needed. Blocking IO: one sync write and one sync read per tick, on the control
-//! thread, each bounded by a reply timeout ([`REPLY_TIMEOUT`] unless set otherwise); the sync read may be put on the bus ahead of the tick
-//! ([`GripperBus::request_present`]) so that the tick only collects its replies.
+//! and no retry is needed. Blocking IO, each reply bounded by a timeout ([`REPLY_TIMEOUT`] unless
+//! set otherwise): the cell sets the bus up and puts it in its safe state directly, and while
+//! active drives it from an IO thread of its own ([`super::dxl_link`]), one sync read and one sync
+//! write per tick.
 //!
 //! Set-up: torque off, Operating Mode 4 (extended position: the growth pinion turns 1.9 times over
 //! the finger's length and the twine spool up to 680°, beyond one turn of mode 3), torque on, goal
@@ -13,8 +14,8 @@
 //! retracted and untwined when the cell is configured (tick 0 of the run = motor angle 0).
 //! Safe state on stop: torque stays ON with goal = present position, so the finger holds the
 //! object instead of going limp (torque off would drop it).
-//! Timing: at 57 600 baud a sync write plus sync read of two motors takes about 6 ms on the wire,
-//! too slow for 500 Hz; real hardware should run the bus at 1 Mbps or more (`hardware.dxl_baud`),
+//! Timing: at 57 600 baud a sync write plus sync read of two motors takes about 6 ms on the wire:
+//! the ticks stay on time (the IO thread is not theirs) but use positions three ticks old; real hardware should run the bus at 1 Mbps or more (`hardware.dxl_baud`),
 //! and a USB adapter with its latency timer at 1 ms (FTDI's default is 16 ms).
 
 use super::protocol::dynamixel::control_table::addr;
@@ -42,8 +43,6 @@ pub struct GripperBus {
     offsets: [i32; 2],
     chunk: Vec<u8>,
     reply_timeout: Duration,
-    /// A sync read of Present Position is on the bus, its replies not yet collected.
-    pending: bool,
 }
 
 fn err(cause: impl std::fmt::Display) -> String {
@@ -70,7 +69,6 @@ impl GripperBus {
             offsets: [0; 2],
             chunk: vec![0; 1024],
             reply_timeout,
-            pending: false,
         };
         for id in [growth_id, twine_id] {
             let status = bus.transact(id, Instruction::Ping)?;
@@ -132,29 +130,16 @@ impl GripperBus {
         }
     }
 
-    /// Puts a sync read of Present Position on the bus without waiting for the replies: the next
-    /// [`Self::present_rad`] collects them. Sent shortly before a tick, it takes the bus round trip
-    /// (a USB adapter's latency timer, the kernel's tty path) out of the tick.
-    pub fn request_present(&mut self) -> Result<(), String> {
-        if !self.pending {
-            self.send(&InstructionPacket {
-                id: super::protocol::dynamixel::BROADCAST_ID,
-                instruction: Instruction::SyncRead {
-                    address: addr::PRESENT_POSITION,
-                    length: 4,
-                    ids: vec![self.growth_id, self.twine_id],
-                },
-            })?;
-            self.pending = true;
-        }
-        Ok(())
-    }
-
-    /// Present positions [growth, twine] in raw ticks: the replies to the sync read requested
-    /// before, or to one sent now.
+    /// Present positions [growth, twine] in raw ticks (one sync read).
     fn present_ticks(&mut self) -> Result<[i32; 2], String> {
-        self.request_present()?;
-        self.pending = false;
+        self.send(&InstructionPacket {
+            id: super::protocol::dynamixel::BROADCAST_ID,
+            instruction: Instruction::SyncRead {
+                address: addr::PRESENT_POSITION,
+                length: 4,
+                ids: vec![self.growth_id, self.twine_id],
+            },
+        })?;
         let mut out = [0i32; 2];
         for (slot, id) in out.iter_mut().zip([self.growth_id, self.twine_id]) {
             let status = self.receive(id)?;

@@ -32,10 +32,14 @@ pub struct LatencyReport {
 /// pose; latency = end of `write` − the tick's deadline (wake-up lateness + read + write).
 pub fn measure(cell: &mut dyn Cell, rate_hz: f64, seconds: f64) -> Result<LatencyReport, CellError> {
     cell.configure()?;
-    // Deadlines count from just before activation (cell time 0), so latency is never understated.
-    let start = Instant::now();
     cell.activate()?;
-    let result = tick_loop(&mut OnCell(&mut *cell), rate_hz, seconds, start);
+    // The schedule is the cell's clock: its time 0, from a first read. Taken before the read, so
+    // the deadlines are never later than the cell's and latency is never understated.
+    let before = Instant::now();
+    let result = cell.read().and_then(|first| {
+        let start = before.checked_sub(Duration::from_secs_f64(first.time_s)).unwrap_or(before);
+        tick_loop(&mut OnCell(&mut *cell), rate_hz, seconds, start)
+    });
     let stop = cell.deactivate();
     let report = result?;
     stop?;

@@ -2,7 +2,8 @@
 //! motion program upload on 30002.
 //!
 //! A reader task decodes the 500 Hz output stream into the latest [`ArmSample`]; the control
-//! thread writes the targets and the enable flag as one input data package per tick.
+//! thread writes the targets and the enable flag as one input data package per tick, without
+//! waiting on the socket ([`UrClient::try_send`]).
 
 use super::protocol::rtde::{ClientEvent, ClientSession, RtdeValue};
 use super::tcp;
@@ -18,6 +19,10 @@ pub const OUTPUT_NAMES: [&str; 7] =
 
 /// RTDE output rate [Hz]: the e-Series maximum.
 pub const OUTPUT_RATE_HZ: f64 = 500.0;
+
+/// Input bytes the socket may hold back before the controller counts as not reading: about 30
+/// ticks' packages.
+const MAX_UNSENT: usize = 2048;
 
 /// How long each set-up reply may take.
 const SETUP_TIMEOUT: Duration = Duration::from_secs(3);
@@ -55,6 +60,8 @@ pub struct UrClient {
     session: ClientSession,
     writer: OwnedWriteHalf,
     input_recipe: u8,
+    /// Input bytes the socket has not taken yet (sent first next time, so packages stay whole).
+    unsent: Vec<u8>,
     /// Shared with the reader task.
     pub feed: Arc<Mutex<ArmFeed>>,
     reader: tokio::task::JoinHandle<()>,
@@ -102,15 +109,43 @@ impl UrClient {
         client_session.handle(super::protocol::rtde::ServerPacket::Start { accepted: true }).map_err(err)?;
         let feed = Arc::new(Mutex::new(ArmFeed::default()));
         let reader = tokio::spawn(read_outputs(reader, buf, client_session, output_recipe, feed.clone()));
-        Ok(UrClient { session, writer, input_recipe, feed, reader })
+        Ok(UrClient { session, writer, input_recipe, unsent: Vec::with_capacity(MAX_UNSENT), feed, reader })
     }
 
-    /// Writes the six targets [rad] and the enable flag in one data package.
+    /// Writes the six targets [rad] and the enable flag in one data package and waits until the
+    /// socket took it (and anything held back before it).
     pub async fn send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
+        self.queue(q, enable)?;
+        self.writer.write_all(&self.unsent).await.map_err(err)?;
+        self.unsent.clear();
+        Ok(())
+    }
+
+    /// Writes the package without waiting: what the socket does not take now is held back and
+    /// goes first next time. Fails if the controller stops reading (more than [`MAX_UNSENT`] bytes
+    /// held back) or the connection broke.
+    pub fn try_send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
+        self.queue(q, enable)?;
+        while !self.unsent.is_empty() {
+            match self.writer.try_write(&self.unsent) {
+                Ok(n) => drop(self.unsent.drain(..n)),
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break,
+                Err(e) => return Err(err(e)),
+            }
+        }
+        if self.unsent.len() > MAX_UNSENT {
+            return Err(err(format!("controller not reading: {} input bytes held back", self.unsent.len())));
+        }
+        Ok(())
+    }
+
+    /// Appends the input data package for `q` and `enable` to the bytes to send.
+    fn queue(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
         let mut values: Vec<RtdeValue> = q.iter().map(|&v| RtdeValue::Double(v)).collect();
         values.push(RtdeValue::Int32(i32::from(enable)));
         let packet = self.session.input_data(self.input_recipe, &values).map_err(err)?;
-        self.writer.write_all(&packet.encode().map_err(err)?).await.map_err(err)
+        self.unsent.extend_from_slice(&packet.encode().map_err(err)?);
+        Ok(())
     }
 
     /// The latest sample and its age, or why the stream ended.
