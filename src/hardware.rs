@@ -28,11 +28,11 @@ pub enum Lifecycle {
 pub struct CellState {
     /// Cell time in seconds since activation (simulated or wall clock).
     pub time_s: f64,
-    /// Measured arm joint positions [rad].
+    /// Measured arm joint positions \[rad\].
     pub arm_q: [f64; ARM_JOINTS],
-    /// Measured growth motor position [rad] (the MX-106 feeding the strip out).
+    /// Measured growth motor position \[rad\] (the MX-106 feeding the strip out).
     pub growth_motor_rad: f64,
-    /// Measured twine motor position [rad] (the MX-106 pulling the curl tendon).
+    /// Measured twine motor position \[rad\] (the MX-106 pulling the curl tendon).
     pub twine_motor_rad: f64,
     /// The latest interrogator sample.
     pub wavelengths: Wavelengths,
@@ -41,28 +41,28 @@ pub struct CellState {
 /// What the control code asks of the cell at each tick. Position targets, radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct CellCommand {
-    /// Arm joint position targets [rad]; the caller keeps them within speed and acceleration limits.
+    /// Arm joint position targets \[rad\]; the caller keeps them within speed and acceleration limits.
     pub arm_q: [f64; ARM_JOINTS],
-    /// Growth motor position target [rad].
+    /// Growth motor position target \[rad\].
     pub growth_motor_rad: f64,
-    /// Twine motor position target [rad].
+    /// Twine motor position target \[rad\].
     pub twine_motor_rad: f64,
 }
 
 /// Quantities only a simulation knows; logged in traces when the cell offers them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
 pub struct GroundTruth {
-    /// True normal force on the sensor bump [N].
+    /// True normal force on the sensor bump \[N\].
     pub sensor_force_n: f64,
-    /// Total normal force between finger and object [N].
+    /// Total normal force between finger and object \[N\].
     pub grip_force_n: f64,
-    /// Height of the object's centre of mass above the table top [m].
+    /// Height of the object's centre of mass above the table top \[m\].
     pub object_height_m: f64,
     /// Speed of the object relative to the hand [m/s].
     pub slip_speed_m_s: f64,
     /// Whether the finger (or pad) touches the object at all.
     pub in_contact: bool,
-    /// Where the object's grip point sits in the hand's frame [m]; its change is slip.
+    /// Where the object's grip point sits in the hand's frame \[m\]; its change is slip.
     pub object_in_hand_m: [f64; 3],
 }
 
@@ -80,7 +80,7 @@ pub enum CellError {
     /// The physics diverged or failed; `time_s` is when it was detected.
     #[error("physics failed at t = {time_s:.4} s: {cause}")]
     Physics {
-        /// Simulated time of detection [s].
+        /// Simulated time of detection \[s\].
         time_s: f64,
         /// What went wrong.
         cause: String,

@@ -18,6 +18,8 @@
 //! - [`reproduce`]: the paper's figures next to the twin's.
 //! - [`signals`]: the data types that cross the seam (wavelengths, ...).
 
+#![warn(missing_docs)]
+
 pub mod calibration;
 pub mod cell;
 pub mod cli;

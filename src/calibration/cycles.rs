@@ -92,7 +92,7 @@ pub fn segment(smoothed: &[f64]) -> (Vec<Cycle>, Vec<Branch>) {
 }
 
 /// Largest gap `mean(unloading) − mean(loading)` of `signal` between the two branches, in bins of
-/// `bin_width` of the (smoothed) force `x`, averaged over [`GAP_AVERAGE_BINS`] neighbouring bins to
+/// `bin_width` of the (smoothed) force `x`, averaged over `GAP_AVERAGE_BINS` neighbouring bins to
 /// damp noise.
 /// Returns `(gap, force at the gap)`, or `None` when no bin has samples on both branches.
 pub fn max_branch_gap(x: &[f64], signal: &[f64], branches: &[Branch], bin_width: f64) -> Option<(f64, f64)> {

@@ -11,9 +11,9 @@ use nalgebra::DMatrix;
 
 /// The procedures take their tare over the first this many seconds of a record (unloaded).
 pub const TARE_WINDOW_S: f64 = 0.5;
-/// Force bins for the hysteresis study [N].
+/// Force bins for the hysteresis study \[N\].
 pub const HYSTERESIS_BIN_N: f64 = 0.1;
-/// Play widths [N] of the hysteresis model fitted for software compensation: spread over the
+/// Play widths \[N\] of the hysteresis model fitted for software compensation: spread over the
 /// range so the fitted weights can shape any lens-like loop (modeling.md: 3-5 plays).
 pub const COMPENSATION_PLAY_WIDTHS_N: [f64; 5] = [0.25, 0.5, 1.0, 1.5, 2.0];
 
@@ -24,25 +24,25 @@ pub struct ForceFit {
     pub a_pm_per_n2: f64,
     /// Fitted `b` [pm/N].
     pub b_pm_per_n: f64,
-    /// Fitted `c` [pm].
+    /// Fitted `c` \[pm\].
     pub c_pm: f64,
     /// R² of the fit [-].
     pub r2: f64,
-    /// RMSE of the fit [pm].
+    /// RMSE of the fit \[pm\].
     pub rmse_pm: f64,
-    /// RMSE of the force read back through eq. (8) against the load cell [N].
+    /// RMSE of the force read back through eq. (8) against the load cell \[N\].
     pub rmse_n: f64,
     /// Mean peak shift over mean peak force of the cycles [pm/N] (the paper's 5482.78 pm / 4.69 N).
     pub sensitivity_pm_per_n: f64,
-    /// Mean peak FBG1 shift of the cycles [pm] (full scale).
+    /// Mean peak FBG1 shift of the cycles \[pm\] (full scale).
     pub span_pm: f64,
-    /// Mean peak load-cell force of the cycles [N] (the range exercised).
+    /// Mean peak load-cell force of the cycles \[N\] (the range exercised).
     pub peak_force_n: f64,
     /// Number of load/unload cycles found.
     pub cycles: usize,
     /// Largest hysteresis, as % of full scale (`span_pm`) [%].
     pub hysteresis_percent: f64,
-    /// Force where the largest hysteresis occurs [N].
+    /// Force where the largest hysteresis occurs \[N\].
     pub hysteresis_at_n: f64,
 }
 
@@ -146,13 +146,13 @@ fn times_of(record: &BenchRecord, idx: &[usize]) -> Vec<f64> {
 /// The sensor's force readings against the load cell.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Comparison {
-    /// RMSE of the estimate against the load cell [N].
+    /// RMSE of the estimate against the load cell \[N\].
     pub rmse_n: f64,
     /// RMSE as % of the calibration's range [%] (the paper's "percentage error").
     pub percent_of_range: f64,
     /// Largest gap between the unloading and the loading branch of the estimate, % of range [%].
     pub hysteresis_percent: f64,
-    /// Force where that gap occurs [N].
+    /// Force where that gap occurs \[N\].
     pub hysteresis_at_n: f64,
 }
 
@@ -173,7 +173,7 @@ pub fn compare(record: &BenchRecord, cal: &ForceCalibration) -> Result<Compariso
     })
 }
 
-/// The tracked (temperature- and, if configured, hysteresis-compensated) force of every row [N].
+/// The tracked (temperature- and, if configured, hysteresis-compensated) force of every row \[N\].
 pub fn track_all(record: &BenchRecord, cal: &ForceCalibration) -> Result<Vec<f64>, CalibrationError> {
     let mut est = ForceEstimator::new(cal.clone());
     est.tare(record.tare(TARE_WINDOW_S).ok_or(CalibrationError::Empty)?);

@@ -45,7 +45,7 @@ pub enum CalibrationError {
     /// No sample in the settled window of the compensation test.
     #[error("no sample at or after the settle time {settle_s} s")]
     NoSettledData {
-        /// The settle time [s].
+        /// The settle time \[s\].
         settle_s: f64,
     },
     /// A fit failed.

@@ -20,13 +20,13 @@ pub const CSV_HEADER: &str = "time_s,load_cell_n,fbg1_nm,fbg2_nm,temperature_c";
 /// One recorded sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BenchRow {
-    /// Time since the start [s].
+    /// Time since the start \[s\].
     pub time_s: f64,
-    /// Load-cell force [N], if the bench has one.
+    /// Load-cell force \[N\], if the bench has one.
     pub load_cell_n: Option<f64>,
-    /// FBG1 peak wavelength [nm].
+    /// FBG1 peak wavelength \[nm\].
     pub fbg1_nm: f64,
-    /// FBG2 peak wavelength [nm].
+    /// FBG2 peak wavelength \[nm\].
     pub fbg2_nm: f64,
     /// Thermometer reading [°C], if the bench has one.
     pub temperature_c: Option<f64>,

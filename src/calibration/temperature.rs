@@ -23,7 +23,7 @@ pub struct TemperatureFit {
     pub r: f64,
 }
 
-/// Linear fits of both wavelength shifts [pm] on the thermometer reading [°C] (no load).
+/// Linear fits of both wavelength shifts \[pm\] on the thermometer reading [°C] (no load).
 pub fn temperature_calibration(record: &BenchRecord) -> Result<TemperatureFit, CalibrationError> {
     let (mut t, mut d1, mut d2) = (Vec::new(), Vec::new(), Vec::new());
     for r in &record.rows {
@@ -52,15 +52,15 @@ pub fn temperature_calibration(record: &BenchRecord) -> Result<TemperatureFit, C
 /// Result of the compensation test.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompensationResult {
-    /// The settled compensated reading the errors are measured from [N] (the paper's "0.1 N").
+    /// The settled compensated reading the errors are measured from \[N\] (the paper's "0.1 N").
     pub reference_n: f64,
-    /// RMSE of the compensated reading about the reference after settling [N].
+    /// RMSE of the compensated reading about the reference after settling \[N\].
     pub compensated_rmse_n: f64,
-    /// RMSE of the uncompensated reading about the reference after settling [N].
+    /// RMSE of the uncompensated reading about the reference after settling \[N\].
     pub uncompensated_rmse_n: f64,
-    /// Largest uncompensated error after settling [N].
+    /// Largest uncompensated error after settling \[N\].
     pub max_uncompensated_error_n: f64,
-    /// FBG2 shift over the last `window_s` of the test from the tare [pm]; divided by `K_T2` it is
+    /// FBG2 shift over the last `window_s` of the test from the tare \[pm\]; divided by `K_T2` it is
     /// the temperature change the paper reads from the strain-free grating (11 °C).
     pub fbg2_shift_pm: f64,
 }

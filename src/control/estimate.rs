@@ -30,11 +30,11 @@ pub struct ForceCalibration {
     pub a_pm_per_n2: f64,
     /// Linear coefficient `b` [pm/N]; paper: 527.62.
     pub b_pm_per_n: f64,
-    /// Intercept `c` [pm]; paper: −91.42.
+    /// Intercept `c` \[pm\]; paper: −91.42.
     pub c_pm: f64,
     /// Temperature sensitivity ratio `r = K_T1/K_T2` [-]; paper: 24.29/10.31 = 2.356.
     pub r: f64,
-    /// Measuring range [N]; paper: 4.69.
+    /// Measuring range \[N\]; paper: 4.69.
     pub range_n: f64,
     /// Optional software hysteresis compensation: a PI model mapping the true force to the eq. (8)
     /// estimate (fitted by `calibration::fit_hysteresis_model`); `None` (the paper) disables it.
@@ -71,18 +71,18 @@ impl Validate for ForceCalibration {
 /// One force estimate.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Estimate {
-    /// Temperature-compensated force, eq. (8) [N] (hysteresis-compensated too when enabled and the
+    /// Temperature-compensated force, eq. (8) \[N\] (hysteresis-compensated too when enabled and the
     /// estimate came from [`ForceEstimator::track`]). May be slightly negative near zero force: the
     /// fitted curve's intercept is not zero, and the value is reported as computed.
     pub force_n: f64,
-    /// Eq. (8) without the `r·Δλ2` term [N]: the paper's "without compensation". Where its
+    /// Eq. (8) without the `r·Δλ2` term \[N\]: the paper's "without compensation". Where its
     /// discriminant is negative it is the curve's vertex `−b/2a` (never NaN).
     pub uncompensated_n: f64,
     /// The reading is at or above [`OVER_RANGE_FRACTION`] of the range: the sensor may be saturated.
     pub over_range: bool,
-    /// FBG1 shift from the tare [pm].
+    /// FBG1 shift from the tare \[pm\].
     pub delta1_pm: f64,
-    /// FBG2 shift from the tare [pm].
+    /// FBG2 shift from the tare \[pm\].
     pub delta2_pm: f64,
 }
 
@@ -95,15 +95,15 @@ pub enum EstimateError {
     /// A wavelength is NaN or infinite.
     #[error("non-finite wavelength ({fbg1_nm} nm, {fbg2_nm} nm)")]
     NonFinite {
-        /// FBG1 reading [nm].
+        /// FBG1 reading \[nm\].
         fbg1_nm: f64,
-        /// FBG2 reading [nm].
+        /// FBG2 reading \[nm\].
         fbg2_nm: f64,
     },
     /// `b² − 4a(c − s) < 0`: the compensated shift lies below the fitted curve's minimum.
     #[error("invalid discriminant: compensated shift {shift_pm:.1} pm is below the calibration curve's minimum")]
     InvalidDiscriminant {
-        /// The compensated strain shift `Δλ1 − r·Δλ2` [pm].
+        /// The compensated strain shift `Δλ1 − r·Δλ2` \[pm\].
         shift_pm: f64,
     },
 }

@@ -12,10 +12,10 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GripperConfig {
-    /// Pitch radius of the growth pinion [m]. 12 mm: a module-1 spur gear of 24 teeth, a size
+    /// Pitch radius of the growth pinion \[m\]. 12 mm: a module-1 spur gear of 24 teeth, a size
     /// that fits the MX-106 horn; 14 cm of growth is then 1.9 motor turns.
     pub growth_pinion_radius_m: f64,
-    /// Radius of the twine tendon spool [m]. With the finger's stiffness this sets the force gain
+    /// Radius of the twine tendon spool \[m\]. With the finger's stiffness this sets the force gain
     /// dF/dθ that the paper's PID gains act on (see `control::pid`). Tuned: 16 mm, so that, as in the
     /// paper, Kp = 20 (°/s)/N brings the pad to 90 % of the setpoint within 5 s (twin: 1-4.6 s over
     /// seeds 1-5): 0.28 mm of tendon per motor degree; at the start of the grasp the pad force grows
@@ -45,17 +45,17 @@ impl Validate for GripperConfig {
 }
 
 impl GripperConfig {
-    /// Growth motor angle [rad] that feeds out `length_m` of finger.
+    /// Growth motor angle \[rad\] that feeds out `length_m` of finger.
     pub fn growth_motor_rad(&self, length_m: f64) -> f64 {
         length_m / self.growth_pinion_radius_m
     }
 
-    /// Finger length fed out [m] at growth motor angle `rad`.
+    /// Finger length fed out \[m\] at growth motor angle `rad`.
     pub fn growth_length_m(&self, rad: f64) -> f64 {
         rad * self.growth_pinion_radius_m
     }
 
-    /// Tendon pulled in [m] at twine motor angle `rad`.
+    /// Tendon pulled in \[m\] at twine motor angle `rad`.
     pub fn tendon_pull_m(&self, rad: f64) -> f64 {
         rad * self.twine_spool_radius_m
     }

@@ -24,7 +24,7 @@ pub struct PidConfig {
     /// Output limit [°/s], symmetric. 90 °/s is a third of the MX-106's no-load speed at 12 V
     /// (45 rpm = 270 °/s, ROBOTIS datasheet), leaving torque margin while twining.
     pub max_speed_deg_s: f64,
-    /// Time constant of the first-order filter on the derivative term [s] (only used when kd ≠ 0).
+    /// Time constant of the first-order filter on the derivative term \[s\] (only used when kd ≠ 0).
     pub derivative_filter_s: f64,
 }
 

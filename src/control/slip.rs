@@ -12,12 +12,12 @@ pub struct SlipConfig {
     /// (the setpoint). 0.5: the paper's held runs dip to 72 % of the setpoint at worst
     /// (crimper, 0.43 N of 0.6 N), so half the setpoint is clearly outside normal fluctuation.
     pub slip_fraction: f64,
-    /// Contact is taken as lost when the estimate is within this force [N] of the unloaded
+    /// Contact is taken as lost when the estimate is within this force \[N\] of the unloaded
     /// reading: 20× the sensor's noise-limited resolution (2.57 mN, paper Sec. IV-B). The
     /// unloaded reading is not 0 N with the paper's calibration (its −91.42 pm intercept makes
     /// eq. (8) read ≈ 0.16 N at zero shift), so the threshold is relative to it.
     pub lost_force_n: f64,
-    /// The force must stay below `lost_force_n` this long [s] before the object is declared
+    /// The force must stay below `lost_force_n` this long \[s\] before the object is declared
     /// lost, so single noisy samples do not trigger it.
     pub lost_hold_s: f64,
 }
@@ -39,9 +39,9 @@ impl Validate for SlipConfig {
 /// What the detector has seen so far.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct SlipEvents {
-    /// When the estimate first fell below `slip_fraction` × reference while holding [s].
+    /// When the estimate first fell below `slip_fraction` × reference while holding \[s\].
     pub slip_start_s: Option<f64>,
-    /// When the force fell below `lost_force_n` (for at least `lost_hold_s`) while holding [s].
+    /// When the force fell below `lost_force_n` (for at least `lost_hold_s`) while holding \[s\].
     pub lost_s: Option<f64>,
 }
 

@@ -78,9 +78,9 @@ pub struct TaskConfig {
     /// end of the lowering, loading the pad by up to 3× the setpoint while the arm still moves
     /// (tuned so that the fluctuation while moving is the grip's, as in the paper's Fig. 9).
     pub place_deg: [f64; ARM_JOINTS],
-    /// Time at home before growing, while the sensor is tared [s].
+    /// Time at home before growing, while the sensor is tared \[s\].
     pub settle_s: f64,
-    /// Finger growth [m]. Paper Sec. V-B: 14.0 cm.
+    /// Finger growth \[m\]. Paper Sec. V-B: 14.0 cm.
     pub growth_m: f64,
     /// Growth feed speed [m/s]. 5 cm/s is a quarter of what the MX-106 (45 rpm) gives on a
     /// 12 mm pinion, a gentle feed for a soft strip.
@@ -90,24 +90,24 @@ pub struct TaskConfig {
     /// near first contact, well below the setpoint, and the PID does the rise, as in the paper
     /// (at the PID's own limit, 90 °/s, the close overshot every setpoint before the PID started).
     pub wrap_speed_deg_s: f64,
-    /// Rise of the force estimate above its unloaded reading that ends the guarded close [N]:
+    /// Rise of the force estimate above its unloaded reading that ends the guarded close \[N\]:
     /// first contact. 0.1 N is 40× the noise-limited resolution (paper: 2.57 mN), well clear of
     /// noise, and a sixth of the smallest setpoint (0.6 N), early enough to start force control.
     pub wrap_contact_n: f64,
-    /// Longest guarded close [s]; past it the grasp starts anyway (and will likely fail).
+    /// Longest guarded close \[s\]; past it the grasp starts anyway (and will likely fail).
     pub wrap_timeout_s: f64,
-    /// Grasp period under force control before the arm moves [s]. Paper Sec. V-B: 15 s.
+    /// Grasp period under force control before the arm moves \[s\]. Paper Sec. V-B: 15 s.
     pub grasp_s: f64,
-    /// Shortest lift duration [s]. The paper reports the crimper dropping "during the upward
+    /// Shortest lift duration \[s\]. The paper reports the crimper dropping "during the upward
     /// motion" at ≈ 10 s after the arm started: the lift lasts 11 s.
     pub lift_s: f64,
-    /// Shortest transfer duration [s]: the shampoo bottle slips "during the horizontal transfer"
+    /// Shortest transfer duration \[s\]: the shampoo bottle slips "during the horizontal transfer"
     /// at ≈ 13 s, so the transfer spans 11-16 s.
     pub transfer_s: f64,
-    /// Shortest lowering duration [s]: the hammer falls "as the arm approaches the collection
+    /// Shortest lowering duration \[s\]: the hammer falls "as the arm approaches the collection
     /// site" at ≈ 17 s, so the approach spans 16-21 s.
     pub lower_s: f64,
-    /// Time to uncurl the finger at the end [s].
+    /// Time to uncurl the finger at the end \[s\].
     pub release_s: f64,
     /// Joint speed and acceleration limits during the moves.
     pub limits: JointLimits,
@@ -225,7 +225,7 @@ impl TaskSequencer {
         }
     }
 
-    /// Sets what the estimator reads with nothing on the sensor [N] (the estimate at the tare);
+    /// Sets what the estimator reads with nothing on the sensor \[N\] (the estimate at the tare);
     /// the guarded close looks for a rise above it.
     pub fn set_unloaded_reading(&mut self, force_n: f64) {
         self.unloaded_n = force_n;
@@ -236,12 +236,12 @@ impl TaskSequencer {
         self.phase
     }
 
-    /// The force setpoint [N].
+    /// The force setpoint \[N\].
     pub fn setpoint_n(&self) -> f64 {
         self.setpoint_n
     }
 
-    /// Cell time at which the arm started to move the object [s], once it has.
+    /// Cell time at which the arm started to move the object \[s\], once it has.
     pub fn motion_start_s(&self) -> Option<f64> {
         self.motion_start_s
     }

@@ -78,7 +78,7 @@ impl JointMove {
         JointMove { from, to, duration_s, ramp_s: peak_rate / a, peak_rate }
     }
 
-    /// How long the move takes [s].
+    /// How long the move takes \[s\].
     pub fn duration_s(&self) -> f64 {
         self.duration_s
     }
@@ -106,7 +106,7 @@ impl JointMove {
         }
     }
 
-    /// Joint positions [rad] and velocities [rad/s] at time `t` after the start.
+    /// Joint positions \[rad\] and velocities [rad/s] at time `t` after the start.
     pub fn sample(&self, t: f64) -> ([f64; ARM_JOINTS], [f64; ARM_JOINTS]) {
         let (s, rate) = self.progress(t);
         let mut q = [0.0; ARM_JOINTS];

@@ -20,15 +20,15 @@ pub struct SpeedAccuracyRow {
     pub integrator: String,
     /// Friction cone ("pyramidal", "elliptic").
     pub cone: String,
-    /// Physics timestep [s].
+    /// Physics timestep \[s\].
     pub timestep_s: f64,
     /// Finger links.
     pub segments: u32,
     /// Simulated seconds per wall-clock second (None if the run failed before measuring).
     pub sim_s_per_wall_s: Option<f64>,
-    /// RMSE of the sensor force against the reference run [N].
+    /// RMSE of the sensor force against the reference run \[N\].
     pub force_rmse_n: Option<f64>,
-    /// Drop-time error against the reference [s] (None when neither dropped).
+    /// Drop-time error against the reference \[s\] (None when neither dropped).
     pub drop_time_error_s: Option<f64>,
     /// "ok", "diverged" or "error".
     pub status: String,

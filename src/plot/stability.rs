@@ -16,7 +16,7 @@ pub struct StabilityRow {
     pub backend: String,
     /// Integrator name.
     pub integrator: String,
-    /// Physics timestep [s].
+    /// Physics timestep \[s\].
     pub timestep_s: f64,
     /// "stable", "diverged", "penetration" or "lost_grasp".
     pub outcome: String,

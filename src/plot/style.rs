@@ -16,15 +16,15 @@ pub fn register_fonts() {
     });
 }
 
-/// Title text size [px].
+/// Title text size \[px\].
 pub const TITLE: u32 = 26;
-/// Panel caption size [px].
+/// Panel caption size \[px\].
 pub const CAPTION: u32 = 20;
-/// Axis description size [px].
+/// Axis description size \[px\].
 pub const AXIS: u32 = 18;
-/// Tick label and legend size [px].
+/// Tick label and legend size \[px\].
 pub const LABEL: u32 = 15;
-/// Small annotation size [px].
+/// Small annotation size \[px\].
 pub const SMALL: u32 = 13;
 
 /// Categorical palette (Okabe–Ito, colour-blind safe), for series.

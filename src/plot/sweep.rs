@@ -19,11 +19,11 @@ pub struct SweepRow {
     pub kp: f64,
     /// Integral gain [(°/s)/(N·s)].
     pub ki: f64,
-    /// Force setpoint [N] (None if the column is absent or empty).
+    /// Force setpoint \[N\] (None if the column is absent or empty).
     pub setpoint_n: Option<f64>,
     /// "held", "dropped" or "error".
     pub outcome: String,
-    /// Rise time to 90 % of the setpoint [s].
+    /// Rise time to 90 % of the setpoint \[s\].
     pub rise_time_90_s: Option<f64>,
     /// Overshoot [% of setpoint].
     pub overshoot_pct: Option<f64>,

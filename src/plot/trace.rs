@@ -17,17 +17,17 @@ pub const PHASES: [&str; 9] = ["home", "grow", "wrap", "grasp", "lift", "transfe
 /// One control tick of the trace (the columns the chart uses).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TracePoint {
-    /// Cell time since activation [s].
+    /// Cell time since activation \[s\].
     pub time_s: f64,
     /// Task phase name.
     pub phase: String,
-    /// True normal force on the sensor [N] (NaN without ground truth).
+    /// True normal force on the sensor \[N\] (NaN without ground truth).
     pub true_force_n: f64,
-    /// Temperature-compensated estimate [N].
+    /// Temperature-compensated estimate \[N\].
     pub force_n: f64,
-    /// Estimate without temperature compensation [N].
+    /// Estimate without temperature compensation \[N\].
     pub force_uncompensated_n: f64,
-    /// Force setpoint [N].
+    /// Force setpoint \[N\].
     pub setpoint_n: f64,
     /// Whether the force controller ran.
     pub controller_on: bool,
@@ -59,17 +59,17 @@ pub struct SummaryInfo {
     pub feedback: Option<bool>,
     /// PID gains.
     pub gains: Option<Gains>,
-    /// Force setpoint [N].
+    /// Force setpoint \[N\].
     pub setpoint_n: Option<f64>,
     /// "held", "dropped" or "error".
     pub outcome: Option<String>,
-    /// Time of the drop since activation [s].
+    /// Time of the drop since activation \[s\].
     pub drop_cell_time_s: Option<f64>,
-    /// Time of the drop after the arm started moving [s].
+    /// Time of the drop after the arm started moving \[s\].
     pub drop_time_s: Option<f64>,
     /// Phase of the drop.
     pub drop_phase: Option<String>,
-    /// When the sensor-based detector saw slip start, after the arm started moving [s].
+    /// When the sensor-based detector saw slip start, after the arm started moving \[s\].
     pub slip_detected_s: Option<f64>,
     /// The error that ended the run.
     pub error: Option<String>,

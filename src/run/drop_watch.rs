@@ -9,11 +9,11 @@ use super::runner::Drop;
 use crate::control::task::Phase;
 use crate::hardware::GroundTruth;
 
-/// Contact must be absent this long before the object counts as lost [s]: a contact
+/// Contact must be absent this long before the object counts as lost \[s\]: a contact
 /// flickering during a slip is not yet a drop.
 pub const LOST_CONTACT_S: f64 = 0.3;
 
-/// Slide in the hand that counts as lost [m]: 20 mm, more than the 12 mm sensor pad, so the
+/// Slide in the hand that counts as lost \[m\]: 20 mm, more than the 12 mm sensor pad, so the
 /// grasp no longer has the configuration it was closed in.
 pub const SLIP_OUT_M: f64 = 0.02;
 

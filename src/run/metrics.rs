@@ -7,15 +7,15 @@ use serde::{Deserialize, Serialize};
 /// Closed-loop figures of one run (all from the sensor's estimate, as the paper measures).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct ControlMetrics {
-    /// Time from the start of force control to the first estimate ≥ 90 % of the setpoint [s].
+    /// Time from the start of force control to the first estimate ≥ 90 % of the setpoint \[s\].
     pub rise_time_90_s: Option<f64>,
     /// Largest estimate above the setpoint during the grasp, in % of the setpoint (0 if none).
     pub overshoot_pct: f64,
     /// Largest |F − setpoint| / setpoint while the arm moves [%] (None when nothing was held).
     pub max_fluctuation_pct: Option<f64>,
-    /// Smallest estimate while the arm moves [N].
+    /// Smallest estimate while the arm moves \[N\].
     pub min_moving_force_n: Option<f64>,
-    /// RMS of estimate − true force from the grasp to the release [N] (None without ground truth).
+    /// RMS of estimate − true force from the grasp to the release \[N\] (None without ground truth).
     pub force_rmse_n: Option<f64>,
     /// Whether the loop oscillates on its own: during the grasp (arm still), after first
     /// reaching 90 % of the setpoint, the estimate swings across a ±10 % band around the

@@ -17,11 +17,11 @@ use serde::Serialize;
 /// Everything the control side needs for one run (the cell is configured separately).
 #[derive(Debug, Clone)]
 pub struct ControlPlan {
-    /// Force setpoint [N].
+    /// Force setpoint \[N\].
     pub setpoint_n: f64,
     /// Keep force control on while the arm moves.
     pub feedback: bool,
-    /// Control loop rate [Hz].
+    /// Control loop rate \[Hz\].
     pub rate_hz: f64,
     /// PID gains and limits.
     pub pid: PidConfig,
@@ -50,7 +50,7 @@ pub enum Outcome {
 /// When and where the object was lost.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Drop {
-    /// Cell time of the loss [s].
+    /// Cell time of the loss \[s\].
     pub cell_time_s: f64,
     /// Phase in which it happened.
     pub phase: Phase,
@@ -63,13 +63,13 @@ pub struct RunReport {
     pub outcome: Outcome,
     /// The loss, if any (from ground truth when the cell has it, else from the sensor).
     pub drop: Option<Drop>,
-    /// Cell time when the arm started moving the object [s].
+    /// Cell time when the arm started moving the object \[s\].
     pub motion_start_s: Option<f64>,
     /// What the sensor-based slip detector saw.
     pub slip: SlipEvents,
     /// Rise time, overshoot, fluctuation, estimate error.
     pub metrics: ControlMetrics,
-    /// Cell time reached [s].
+    /// Cell time reached \[s\].
     pub cell_time_s: f64,
     /// The error that ended the run, with its time.
     pub error: Option<String>,

@@ -31,12 +31,12 @@ pub struct PickPlaceScenario {
     /// Seed of every random process (sensor noise) [-]; the same seed gives the same trace.
     #[serde(default = "default_seed")]
     pub seed: u64,
-    /// Contact-force setpoint [N] (paper Sec. V-B: crimper 0.6, hammer 1.6, shampoo 0.8).
+    /// Contact-force setpoint \[N\] (paper Sec. V-B: crimper 0.6, hammer 1.6, shampoo 0.8).
     pub setpoint_n: f64,
     /// Keep force control on while the arm moves (paper: both modes compared).
     #[serde(default = "default_feedback")]
     pub feedback: bool,
-    /// Control loop rate [Hz]. 100 Hz: ten interrogator samples per tick, and ample for a loop
+    /// Control loop rate \[Hz\]. 100 Hz: ten interrogator samples per tick, and ample for a loop
     /// whose closed-loop time constant is about 2 s (paper: 90 % within 5 s).
     #[serde(default = "default_rate")]
     pub control_rate_hz: f64,

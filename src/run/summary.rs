@@ -22,13 +22,13 @@ pub struct RunIdentity {
     pub scenario: String,
     /// Object name.
     pub object: String,
-    /// Object mass [kg].
+    /// Object mass \[kg\].
     pub mass_kg: f64,
     /// Force control kept on while the arm moves.
     pub feedback: bool,
     /// PID gains.
     pub gains: Gains,
-    /// Force setpoint [N].
+    /// Force setpoint \[N\].
     pub setpoint_n: f64,
     /// Seed of every random process in the run.
     pub seed: u64,
@@ -46,20 +46,20 @@ pub struct RunSummary {
     pub run: RunIdentity,
     /// "held", "dropped" or "error".
     pub outcome: String,
-    /// Time of the drop after the arm started moving [s].
+    /// Time of the drop after the arm started moving \[s\].
     pub drop_time_s: Option<f64>,
-    /// Time of the drop since activation [s].
+    /// Time of the drop since activation \[s\].
     pub drop_cell_time_s: Option<f64>,
     /// Phase of the drop.
     pub drop_phase: Option<String>,
-    /// When the sensor-based detector saw slip start, after the arm started moving [s].
+    /// When the sensor-based detector saw slip start, after the arm started moving \[s\].
     pub slip_detected_s: Option<f64>,
     /// Rise time, overshoot, fluctuation, estimate error, oscillation.
     #[serde(flatten)]
     pub metrics: ControlMetrics,
-    /// Simulated (or cell) time covered [s].
+    /// Simulated (or cell) time covered \[s\].
     pub sim_time_s: f64,
-    /// Wall-clock time of the run [s].
+    /// Wall-clock time of the run \[s\].
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub real_time_factor: f64,

@@ -7,37 +7,37 @@ use std::path::Path;
 /// One control tick, as written to `trace.csv`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TraceRow {
-    /// Cell time [s].
+    /// Cell time \[s\].
     pub time_s: f64,
     /// Task phase.
     pub phase: Phase,
-    /// True normal force on the sensor [N] (NaN when the cell has no ground truth).
+    /// True normal force on the sensor \[N\] (NaN when the cell has no ground truth).
     pub true_force_n: f64,
-    /// FBG1 peak [nm].
+    /// FBG1 peak \[nm\].
     pub fbg1_nm: f64,
-    /// FBG2 peak [nm].
+    /// FBG2 peak \[nm\].
     pub fbg2_nm: f64,
-    /// Temperature-compensated force estimate, eq. (8) [N].
+    /// Temperature-compensated force estimate, eq. (8) \[N\].
     pub force_n: f64,
-    /// Estimate without temperature compensation [N].
+    /// Estimate without temperature compensation \[N\].
     pub force_uncompensated_n: f64,
     /// Whether the estimate was flagged over range.
     pub over_range: bool,
-    /// Force setpoint [N].
+    /// Force setpoint \[N\].
     pub setpoint_n: f64,
     /// Whether the force controller ran.
     pub controller_on: bool,
     /// Controller output: twine motor speed [°/s].
     pub controller_output_deg_s: f64,
-    /// Growth motor position [rad].
+    /// Growth motor position \[rad\].
     pub growth_motor_rad: f64,
-    /// Twine motor position [rad].
+    /// Twine motor position \[rad\].
     pub twine_motor_rad: f64,
-    /// Object height above the table [m] (NaN without ground truth).
+    /// Object height above the table \[m\] (NaN without ground truth).
     pub object_height_m: f64,
     /// Object speed relative to the hand [m/s] (NaN without ground truth).
     pub slip_speed_m_s: f64,
-    /// Total grip normal force [N] (NaN without ground truth).
+    /// Total grip normal force \[N\] (NaN without ground truth).
     pub grip_force_n: f64,
 }
 

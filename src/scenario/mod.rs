@@ -1,7 +1,7 @@
 //! Scenario files: TOML in, typed and validated configuration out.
 //!
 //! Every scenario type is read the same way ([`load`]): the file is parsed to a TOML table,
-//! `--set key=value` overrides are applied at their dotted paths ([`overrides`]), the table is
+//! `--set key=value` overrides are applied at their dotted paths ([`apply_overrides`]), the table is
 //! deserialised with unknown keys rejected, and the result is checked with [`Validate`]. Any
 //! failure is a [`ScenarioError`] that names the file, the dotted key and the reason.
 

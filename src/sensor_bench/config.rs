@@ -85,11 +85,11 @@ impl Validate for BenchScenario {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LoadCellConfig {
-    /// Standard deviation of the force noise [N]. Not published (the LTH300's capacity and the
+    /// Standard deviation of the force noise \[N\]. Not published (the LTH300's capacity and the
     /// amplifier are not given; an Uno's 10-bit ADC over a 50 lb cell is 0.22 N per count). Tuned:
     /// 0.095 N makes the calibration's force RMSE the paper's 0.12 N.
     pub noise_n: f64,
-    /// Reported force step [N] (0 = none).
+    /// Reported force step \[N\] (0 = none).
     pub quantization_n: f64,
 }
 
@@ -110,7 +110,7 @@ impl Validate for LoadCellConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RecorderConfig {
-    /// Rows per second [Hz]. 100 Hz: a choice (the paper does not state its logging rate).
+    /// Rows per second \[Hz\]. 100 Hz: a choice (the paper does not state its logging rate).
     pub rate_hz: f64,
     /// Average the interrogator samples within each period (boxcar) instead of keeping the last.
     pub average: bool,
@@ -138,13 +138,13 @@ impl Validate for RecorderConfig {
 pub struct ForceCycles {
     /// Number of cycles [-].
     pub cycles: u32,
-    /// Peak force of each cycle [N]; at most the sensor range.
+    /// Peak force of each cycle \[N\]; at most the sensor range.
     pub peak_force_n: f64,
-    /// Duration of each loading ramp [s].
+    /// Duration of each loading ramp \[s\].
     pub load_time_s: f64,
-    /// Duration of each unloading ramp [s].
+    /// Duration of each unloading ramp \[s\].
     pub unload_time_s: f64,
-    /// Unloaded time before the first cycle (the tare) and after the last [s].
+    /// Unloaded time before the first cycle (the tare) and after the last \[s\].
     pub rest_s: f64,
     /// Lab temperature [°C].
     pub temperature_c: f64,
@@ -172,9 +172,9 @@ pub struct WaterBath {
     pub start_c: f64,
     /// Final water temperature [°C].
     pub end_c: f64,
-    /// Hold at each end [s].
+    /// Hold at each end \[s\].
     pub hold_s: f64,
-    /// Duration of the ramp [s].
+    /// Duration of the ramp \[s\].
     pub ramp_s: f64,
 }
 
@@ -194,31 +194,31 @@ impl Validate for WaterBath {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TapedHeating {
-    /// Total duration [s].
+    /// Total duration \[s\].
     pub duration_s: f64,
     /// Water temperature at the start [°C].
     pub start_c: f64,
     /// Water temperature at the end of heating [°C].
     pub end_c: f64,
-    /// Heating starts [s].
+    /// Heating starts \[s\].
     pub heating_start_s: f64,
-    /// Heating ends (then holds) [s].
+    /// Heating ends (then holds) \[s\].
     pub heating_end_s: f64,
-    /// Tape applied (force starts) [s].
+    /// Tape applied (force starts) \[s\].
     pub tape_on_s: f64,
-    /// Time of the finger's press peak [s].
+    /// Time of the finger's press peak \[s\].
     pub press_time_s: f64,
-    /// Finger force at the peak, on top of the tape [N].
+    /// Finger force at the peak, on top of the tape \[N\].
     pub press_peak_n: f64,
-    /// Duration of the (half-sine) press [s].
+    /// Duration of the (half-sine) press \[s\].
     pub press_width_s: f64,
-    /// Tape force when applied [N].
+    /// Tape force when applied \[N\].
     pub tape_initial_n: f64,
-    /// Tape force after relaxing [N].
+    /// Tape force after relaxing \[N\].
     pub tape_final_n: f64,
-    /// Relaxation time constant of the tape force [s].
+    /// Relaxation time constant of the tape force \[s\].
     pub relax_tau_s: f64,
-    /// From here on the force is taken as settled and the errors are measured [s].
+    /// From here on the force is taken as settled and the errors are measured \[s\].
     pub settle_s: f64,
 }
 

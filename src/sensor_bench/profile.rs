@@ -4,9 +4,9 @@ use super::config::{ForceCycles, TapedHeating, WaterBath};
 
 /// What the bench applies at the sensor over time.
 pub trait Profile {
-    /// Duration of the experiment [s].
+    /// Duration of the experiment \[s\].
     fn duration_s(&self) -> f64;
-    /// True normal force [N] and water/lab temperature [°C] at time `t` [s].
+    /// True normal force \[N\] and water/lab temperature [°C] at time `t` \[s\].
     fn at(&self, t: f64) -> (f64, f64);
 }
 

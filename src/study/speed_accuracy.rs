@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 /// The grid of a speed/accuracy study.
 #[derive(Debug, Clone)]
 pub struct Grid {
-    /// Timesteps [s].
+    /// Timesteps \[s\].
     pub timesteps_s: Vec<f64>,
     /// Integrators (`euler`, `implicitfast`, `implicit`, `rk4`).
     pub integrators: Vec<&'static str>,
@@ -25,7 +25,7 @@ pub struct Grid {
     /// rapier solver iterations per step (the rapier series; empty: MuJoCo only). rapier has one
     /// integrator and its own friction cone, so its points vary iterations instead.
     pub rapier_iterations: Vec<u32>,
-    /// The reference: timestep [s] and links (MuJoCo, implicit integrator, elliptic cone).
+    /// The reference: timestep \[s\] and links (MuJoCo, implicit integrator, elliptic cone).
     pub reference: (f64, u32),
 }
 

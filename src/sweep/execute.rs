@@ -38,7 +38,7 @@ pub struct SweepStats {
     pub errors: usize,
     /// Simulated seconds over all runs executed.
     pub sim_time_s: f64,
-    /// Wall time of the whole sweep [s].
+    /// Wall time of the whole sweep \[s\].
     pub wall_time_s: f64,
 }
 

@@ -56,7 +56,7 @@ fn invalid(file: &Path, key: &str, reason: impl Into<String>) -> ScenarioError {
 }
 
 /// Reads a sweep file and expands it into runs. Scenario contents are not checked here; see
-/// [`super::check_runs`].
+/// [`super::execute::check_runs`].
 pub fn load_sweep(file: &Path) -> Result<Sweep, ScenarioError> {
     let text = std::fs::read_to_string(file).map_err(|source| ScenarioError::Io { file: file.into(), source })?;
     let table: toml::Table = text

@@ -24,10 +24,10 @@ pub struct SensorConfig {
     pub strain_k2_pm_per_n2: f64,
     /// Cubic strain coefficient `k3` [pm/N³]; tuned (negative: the response straightens near the top).
     pub strain_k3_pm_per_n3: f64,
-    /// Measuring range [N]: past it the uvula bottoms out (1 mm gap) and the strain stops growing;
+    /// Measuring range \[N\]: past it the uvula bottoms out (1 mm gap) and the strain stops growing;
     /// paper Sec. IV-B: 4.69 N.
     pub range_n: f64,
-    /// Prandtl-Ishlinskii play widths [N] of the TPU/epoxy hysteresis (one-sided plays, see
+    /// Prandtl-Ishlinskii play widths \[N\] of the TPU/epoxy hysteresis (one-sided plays, see
     /// `control::hysteresis`). Tuned: the widest, 2.0 N = 4.69 − 2.69 N, puts the widest gap of a
     /// 0 → 4.69 → 0 N loop at ≈ 2.68 N (paper Fig. 4b); the narrower ones round the loop's lower half.
     pub hysteresis_widths_n: Vec<f64>,
@@ -38,15 +38,15 @@ pub struct SensorConfig {
     pub kt1_pm_per_c: f64,
     /// FBG2 temperature sensitivity `K_T2` [pm/°C] (strain-free, in the tube); paper: 10.31.
     pub kt2_pm_per_c: f64,
-    /// First-order thermal time constant of FBG1 [s]: it sits inside the 12 × 12 × 4 mm TPU casing
+    /// First-order thermal time constant of FBG1 \[s\]: it sits inside the 12 × 12 × 4 mm TPU casing
     /// (2 mm half-thickness, TPU diffusivity ≈ 1e-7 m²/s: L²/(π²α) ≈ 4-16 s). Tuned with the FBG2
     /// constant: their 5 s mismatch leaves the paper's ≈ 0.01 N compensated residual while heating.
     pub thermal_lag1_s: f64,
-    /// First-order thermal time constant of FBG2 [s]: thin polymer tube, faster. Tuned (see above).
+    /// First-order thermal time constant of FBG2 \[s\]: thin polymer tube, faster. Tuned (see above).
     pub thermal_lag2_s: f64,
-    /// FBG1 unstrained Bragg wavelength at the reference temperature [nm]; paper: 1540.
+    /// FBG1 unstrained Bragg wavelength at the reference temperature \[nm\]; paper: 1540.
     pub lambda1_nm: f64,
-    /// FBG2 Bragg wavelength at the reference temperature [nm]; paper: 1550.
+    /// FBG2 Bragg wavelength at the reference temperature \[nm\]; paper: 1550.
     pub lambda2_nm: f64,
     /// Temperature at which the nominal wavelengths hold [°C]; the lab's 25 °C (paper Sec. IV-B).
     pub reference_temperature_c: f64,
@@ -73,7 +73,7 @@ impl Default for SensorConfig {
 }
 
 impl SensorConfig {
-    /// The backbone strain shift [pm] at effective force `n` [N].
+    /// The backbone strain shift \[pm\] at effective force `n` \[N\].
     #[inline]
     pub fn backbone_pm(&self, n: f64) -> f64 {
         n * (self.strain_k1_pm_per_n + n * (self.strain_k2_pm_per_n2 + n * self.strain_k3_pm_per_n3))
@@ -135,11 +135,11 @@ pub enum InterrogatorMode {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InterrogatorConfig {
-    /// Sample rate [Hz]; the si255 runs at 1 kHz (hardware.md).
+    /// Sample rate \[Hz\]; the si255 runs at 1 kHz (hardware.md).
     pub sample_rate_hz: f64,
-    /// Standard deviation of the peak-wavelength noise in analytic mode [pm]; paper: "≈ 3 pm".
+    /// Standard deviation of the peak-wavelength noise in analytic mode \[pm\]; paper: "≈ 3 pm".
     pub noise_pm: f64,
-    /// Reported wavelength step [pm]; paper: 1 pm resolution.
+    /// Reported wavelength step \[pm\]; paper: 1 pm resolution.
     pub quantization_pm: f64,
     /// `"analytic"` or `"spectral"`.
     pub mode: InterrogatorMode,
@@ -177,18 +177,18 @@ impl Validate for InterrogatorConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SpectralConfig {
-    /// Full width at half maximum of each reflection line [nm]; paper: 0.6-0.7 nm.
+    /// Full width at half maximum of each reflection line \[nm\]; paper: 0.6-0.7 nm.
     pub fwhm_nm: f64,
     /// Peak reflectivity [-]; paper: > 30 %.
     pub reflectivity: f64,
-    /// First sampled wavelength [nm].
+    /// First sampled wavelength \[nm\].
     pub start_nm: f64,
-    /// Last sampled wavelength [nm].
+    /// Last sampled wavelength \[nm\].
     pub end_nm: f64,
-    /// Grid step of the sampled spectrum [pm]. 10 pm: coarse enough for 10 k spectra/s, fine
+    /// Grid step of the sampled spectrum \[pm\]. 10 pm: coarse enough for 10 k spectra/s, fine
     /// enough that the centroid's grid bias stays well under the 3 pm noise.
     pub step_pm: f64,
-    /// Boundary between the FBG1 channel (below) and the FBG2 channel (above) [nm]: FBG1 moves up to
+    /// Boundary between the FBG1 channel (below) and the FBG2 channel (above) \[nm\]: FBG1 moves up to
     /// ≈ 5.5 nm with force, FBG2 stays near 1550 nm.
     pub channel_split_nm: f64,
     /// Standard deviation of the additive intensity noise, relative to full reflection [-]. Tuned so

@@ -43,8 +43,8 @@ impl FbgSensor {
         }
     }
 
-    /// The true (noise-free) Bragg wavelengths [nm] for force `force_n` [N] and temperature
-    /// `temperature_c` [°C], advancing hysteresis and thermal states by `dt_s` [s].
+    /// The true (noise-free) Bragg wavelengths \[nm\] for force `force_n` \[N\] and temperature
+    /// `temperature_c` [°C], advancing hysteresis and thermal states by `dt_s` \[s\].
     #[inline]
     pub fn bragg(&mut self, force_n: f64, temperature_c: f64, dt_s: f64) -> Wavelengths {
         // A contact force is never negative; past the range the uvula rests on the floor.
@@ -58,8 +58,8 @@ impl FbgSensor {
         Wavelengths { fbg1_nm: self.cfg.lambda1_nm + d1_pm * 1e-3, fbg2_nm: self.cfg.lambda2_nm + d2_pm * 1e-3 }
     }
 
-    /// One interrogator sample: the reported peak wavelengths [nm] for the true force [N] and
-    /// temperature [°C] at the sensor; `dt_s` [s] is the time since the previous sample.
+    /// One interrogator sample: the reported peak wavelengths \[nm\] for the true force \[N\] and
+    /// temperature [°C] at the sensor; `dt_s` \[s\] is the time since the previous sample.
     #[inline]
     pub fn sample(&mut self, force_n: f64, temperature_c: f64, dt_s: f64) -> Wavelengths {
         let b = self.bragg(force_n, temperature_c, dt_s);

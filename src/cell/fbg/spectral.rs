@@ -31,12 +31,12 @@ impl SpectralInterrogator {
         }
     }
 
-    /// The last sampled spectrum (reflectivity per grid point) and its grid [nm].
+    /// The last sampled spectrum (reflectivity per grid point) and its grid \[nm\].
     pub fn spectrum(&self) -> (&[f64], &[f64]) {
         (&self.grid_nm, &self.spectrum)
     }
 
-    /// Samples the spectrum for true Bragg wavelengths `b1_nm`, `b2_nm` and returns the detected peaks [nm].
+    /// Samples the spectrum for true Bragg wavelengths `b1_nm`, `b2_nm` and returns the detected peaks \[nm\].
     pub fn detect<R: Rng>(&mut self, b1_nm: f64, b2_nm: f64, rng: &mut R) -> (f64, f64) {
         let (r, noise, shape) = (self.cfg.reflectivity, self.cfg.intensity_noise, self.shape);
         for (s, &l) in self.spectrum.iter_mut().zip(&self.grid_nm) {

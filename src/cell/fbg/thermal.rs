@@ -11,7 +11,7 @@ pub struct ThermalLag {
 }
 
 impl ThermalLag {
-    /// A lag with time constant `tau_s` [s] (0 = no lag); starts in equilibrium with the first input.
+    /// A lag with time constant `tau_s` \[s\] (0 = no lag); starts in equilibrium with the first input.
     pub fn new(tau_s: f64) -> ThermalLag {
         ThermalLag { tau_s, state_c: None, last_dt: f64::NAN, last_decay: 0.0 }
     }

@@ -23,23 +23,23 @@ pub struct CheckScenario {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CheckScript {
-    /// Growth commanded at t = 0 [m].
+    /// Growth commanded at t = 0 \[m\].
     pub growth_m: f64,
-    /// Twine wound in once the strip is grown [m].
+    /// Twine wound in once the strip is grown \[m\].
     pub twine_m: f64,
     /// Winding speed of that ramp [m/s] (a steady wrap; full motor speed flings the strip's tip).
     pub wind_speed_m_s: f64,
-    /// Hold before lifting [s].
+    /// Hold before lifting \[s\].
     pub hold_s: f64,
-    /// Lift height of the hand after the hold [m] (straight up, joint targets by inverse kinematics).
+    /// Lift height of the hand after the hold \[m\] (straight up, joint targets by inverse kinematics).
     pub lift_m: f64,
-    /// Duration of the lift ramp [s].
+    /// Duration of the lift ramp \[s\].
     pub lift_duration_s: f64,
-    /// Time after the lift starts [s].
+    /// Time after the lift starts \[s\].
     pub after_lift_s: f64,
-    /// Print period [s].
+    /// Print period \[s\].
     pub print_every_s: f64,
-    /// Pad-force setpoint [N] of a plain integral loop on the twine, active after the twine ramp;
+    /// Pad-force setpoint \[N\] of a plain integral loop on the twine, active after the twine ramp;
     /// 0 = open loop (the twine stays where the ramp left it). A stand-in for the PID, for tuning only.
     pub pad_setpoint_n: f64,
     /// Gain of that loop [m of tendon per N per s].

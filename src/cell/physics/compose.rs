@@ -11,11 +11,11 @@ const PAD: &str = include_str!("../../../models/sensor_pad.xml");
 const UR5E: &str = include_str!("../../../models/ur5e.xml");
 const TABLE: &str = include_str!("../../../models/table.xml");
 
-/// Height of the pad's bump tip above the casing's base [m]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
+/// Height of the pad's bump tip above the casing's base \[m\]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
 pub const PAD_HEIGHT_M: f64 = 0.0055;
-/// Clearance between the grown, straight strip's bump and the object [m], so growing does not push it.
+/// Clearance between the grown, straight strip's bump and the object \[m\], so growing does not push it.
 pub const GROW_CLEARANCE_M: f64 = 0.001;
-/// Gap between the object and the palm at the start [m]: touching (0.2 mm), so the wrap presses it on
+/// Gap between the object and the palm at the start \[m\]: touching (0.2 mm), so the wrap presses it on
 /// the palm from the start instead of dragging it there part-way through tightening (which shifted the
 /// load off the pad by ~10 %).
 pub const PALM_GAP_M: f64 = 0.0002;
@@ -144,9 +144,9 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
 pub struct Placement {
     /// Tool-flange (= hand frame) pose at the start arm configuration.
     pub hand: Isometry3<f64>,
-    /// Object footprint centre (its body origin) [m]; `None` when the scene has no object.
+    /// Object footprint centre (its body origin) \[m\]; `None` when the scene has no object.
     pub object: Option<Vector3<f64>>,
-    /// Height of the table plane [m].
+    /// Height of the table plane \[m\].
     pub table_z: f64,
 }
 

@@ -94,7 +94,7 @@ pub struct RapierConfig {
     /// Friction model between rigid bodies. `simplified`: modeling.md measured the slip angle within
     /// 0.03 deg of atan(mu) with it, where the Coulomb model slips about 1.5 deg early.
     pub friction_model: RapierFriction,
-    /// Natural frequency of the contact constraints' softness [Hz]. rapier's default, 30.
+    /// Natural frequency of the contact constraints' softness \[Hz\]. rapier's default, 30.
     pub contact_frequency_hz: f64,
     /// Damping ratio of the contact constraints' softness. Tuned: 5 (rapier's default is 10), the
     /// setting, of six tried (16/30 Hz with 1 and 5, 60 Hz with 5, 30 Hz with 10), that reproduces
@@ -105,7 +105,7 @@ pub struct RapierConfig {
     /// fluctuation, limit 40 %). The no-feedback drop times move by seconds across these settings
     /// (models/README.md).
     pub contact_damping_ratio: f64,
-    /// Length scale of rapier's tolerances [m]: slop 0.005 x, speculative margin 0.02 x. rapier is
+    /// Length scale of rapier's tolerances \[m\]: slop 0.005 x, speculative margin 0.02 x. rapier is
     /// tuned for metre-sized bodies (slop 5 mm); the finger is 2 mm thick and grips 25 mm handles,
     /// so 0.02: slop 0.1 mm, margin 0.4 mm.
     pub length_unit_m: f64,
@@ -167,7 +167,7 @@ pub enum ArmMode {
 pub struct PhysicsConfig {
     /// The engine (`mujoco` | `rapier`); `--backend` on the command line sets it too.
     pub backend: Backend,
-    /// Simulation step [s]. 5 ms: the largest step at which the contact time constant (10 ms) is still
+    /// Simulation step \[s\]. 5 ms: the largest step at which the contact time constant (10 ms) is still
     /// two steps (MuJoCo's minimum) and the pinch bound holds to 0.02 %; 2 ms runs ~2.5x slower.
     pub timestep_s: f64,
     /// Integrator. `implicitfast`: the creep dashpot (thousands of N s/m on a 1 g node) and the servos'
@@ -192,23 +192,23 @@ pub struct PhysicsConfig {
     pub noslip_iterations: u32,
     /// No-slip solver tolerance.
     pub noslip_tolerance: f64,
-    /// Contact solref time constant [s] (global default): stiffness of contacts. 0.01 s: two steps at the
+    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 0.01 s: two steps at the
     /// default step (MuJoCo's minimum; it clamps shorter ones); with the finger's armature the strip
     /// sinks about 1 mm into the objects.
     pub contact_timeconst_s: f64,
     /// Contact solref damping ratio (1 = critical).
     pub contact_dampratio: f64,
-    /// Contact solimp (d0, dwidth, width [m]): impedance 0.95 -> 0.99 over 1 mm of penetration.
+    /// Contact solimp (d0, dwidth, width \[m\]): impedance 0.95 -> 0.99 over 1 mm of penetration.
     pub contact_solimp: [f64; 3],
     /// Arm simulation mode (`kinematic` | `dynamic`).
     pub arm_mode: ArmMode,
     /// Kinematic mode: the largest joint speed the commanded targets are followed with [rad/s]; UR5e
     /// maximum 180 deg/s (hardware.md). Targets further away are approached at this speed.
     pub arm_max_speed_rad_s: f64,
-    /// Divergence bound: deepest allowed contact penetration [m]. A finger 5 mm inside an object is not
+    /// Divergence bound: deepest allowed contact penetration \[m\]. A finger 5 mm inside an object is not
     /// a soft contact any more but a blown-up one.
     pub max_penetration_m: f64,
-    /// Divergence bound: largest allowed kinetic energy of the scene [J]. The cell's moving parts hold
+    /// Divergence bound: largest allowed kinetic energy of the scene \[J\]. The cell's moving parts hold
     /// < 5 J at UR5e speeds (20 kg arm at 0.5 m/s); 200 J means runaway.
     pub max_kinetic_energy_j: f64,
     /// The rapier backend's own settings (`[physics.rapier]`).
@@ -279,11 +279,11 @@ pub struct FingerConfig {
     /// 12.5 mm-radius handle is wrapped by ~4.5 segments per turn. 12 or 16 did not change the pad's
     /// share of the force and cost speed.
     pub segments: u32,
-    /// Strip length that can be grown out of the guide [m]; paper Sec. V grows 14.0 cm.
+    /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
-    /// Strip thickness [m] (capsule diameter). 2 mm: a choice for a TPU strip with a tendon channel.
+    /// Strip thickness \[m\] (capsule diameter). 2 mm: a choice for a TPU strip with a tendon channel.
     pub thickness_m: f64,
-    /// Strip width [m] (mass only; the capsules touch along a line). 20 mm, from the photos' proportions.
+    /// Strip width \[m\] (mass only; the capsules touch along a line). 20 mm, from the photos' proportions.
     pub width_m: f64,
     /// Strip density [kg/m^3]. TPU 1200 (typical datasheet value).
     pub density_kg_m3: f64,
@@ -302,7 +302,7 @@ pub struct FingerConfig {
     /// (modeling.md saw the same fix). Side effect: the strip's own curl mode has a period of ~0.6 s,
     /// still much faster than the paper's 5 s force loop; it does not add inertia to the object.
     pub joint_armature_kg_m2: f64,
-    /// Tendon offset from the strip's neutral axis [m] (moment arm of the tendon on each joint). 3 mm.
+    /// Tendon offset from the strip's neutral axis \[m\] (moment arm of the tendon on each joint). 3 mm.
     pub moment_arm_m: f64,
     /// Instantaneous tendon-path stiffness K [N/m] (both SLS branches in parallel): tendon plus the soft
     /// material it pulls on; sets how fast grip grows with twine. Tuned: 3000 (was 2000) with the spool
@@ -315,13 +315,13 @@ pub struct FingerConfig {
     /// tension sits in the creeping branch, as in a soft TPU path whose tendon slides in its channel
     /// (TPU relaxes 30-60 % in minutes at room temperature; the channel friction adds the rest).
     pub relaxed_fraction: f64,
-    /// Relaxation time tau [s] of the standard linear solid (dashpot c = tau (1 - f) K).
+    /// Relaxation time tau \[s\] of the standard linear solid (dashpot c = tau (1 - f) K).
     /// Tuned so that, as in the paper, the three objects drop ≈ 10, 13 and 17 s after the arm
     /// starts: 15 s, with the objects' friction margins, turns the decay of the frozen grip into those
     /// drop times (models/README.md has the figures); 20-30 s let the crimper survive the lift. Seconds
     /// to tens of seconds is the usual range of TPU stress relaxation.
     pub relaxation_time_s: f64,
-    /// Equivalent translating inertia of each MX-106 at its output [kg] (joint armature). A choice.
+    /// Equivalent translating inertia of each MX-106 at its output \[kg\] (joint armature). A choice.
     pub motor_armature_kg: f64,
     /// Position-servo stiffness of both motors [N/m]. A choice: 1 mm error -> 20 N.
     pub motor_kp_n_m: f64,
@@ -330,9 +330,9 @@ pub struct FingerConfig {
     /// Largest speed of either motor's output [m/s]: commands further away are approached at this
     /// speed. MX-106 no-load speed 45 rpm at 12 V (hardware.md) on the 10 mm spool = 0.047 m/s.
     pub motor_max_speed_m_s: f64,
-    /// Largest twine (tendon wound in) [m].
+    /// Largest twine (tendon wound in) \[m\].
     pub twine_max_m: f64,
-    /// Distance of the sensor pad's centre from the strip's base [m] (on the sleeve, near the guide,
+    /// Distance of the sensor pad's centre from the strip's base \[m\] (on the sleeve, near the guide,
     /// paper Sec. V). 43.75 mm: inside the wrap of a 12-14 mm radius handle or neck, and the middle of
     /// the third of 8 segments: a flat segment touches a round handle at its middle, so a pad there is
     /// loaded steadily (a pad over a joint was loaded erratically). Keep it mid-segment when changing
@@ -346,14 +346,14 @@ pub struct FingerConfig {
     /// Modelled as a step of `helix_slope * segment length` between segments (towards the flange).
     /// 0.27: one turn around a 13 mm radius handle (82 mm of strip) rises by the strip's width plus 2 mm.
     pub helix_slope: f64,
-    /// Height of the pad's bump tip above the strip's inner face [m]. The casing is 4 mm tall and the
+    /// Height of the pad's bump tip above the strip's inner face \[m\]. The casing is 4 mm tall and the
     /// bump 1.5 mm (5.5 mm in all) but how deep the casing sits in the sleeve is not published: this sets
     /// how much of the wrap's force the pad takes. Tunable; 2.5 mm (casing 3 mm recessed) gives the pad
     /// ~20-25 % of the strip's normal force (5.5 mm: 30-45 %). The paper's setpoints (0.6-1.6 N on the
     /// pad for objects needing 4-8 N of normal force at their friction) suggest 10-20 %.
     /// Tuned with `pad_position_m`: 3 mm (casing 2.5 mm recessed) gives 15-25 % on the three objects.
     pub pad_protrusion_m: f64,
-    /// Distance below the flange at which the strip leaves the guide [m] (hand length). A choice.
+    /// Distance below the flange at which the strip leaves the guide \[m\] (hand length). A choice.
     pub exit_z_m: f64,
 }
 
@@ -386,7 +386,7 @@ impl Default for FingerConfig {
 }
 
 impl FingerConfig {
-    /// Length of one segment [m].
+    /// Length of one segment \[m\].
     pub fn segment_length_m(&self) -> f64 {
         self.length_m / f64::from(self.segments.max(1))
     }
@@ -462,7 +462,7 @@ impl ObjectName {
         }
     }
 
-    /// Mass from the paper (Sec. V) [kg].
+    /// Mass from the paper (Sec. V) \[kg\].
     pub fn paper_mass_kg(self) -> f64 {
         match self {
             ObjectName::Crimper => 0.351,
@@ -481,7 +481,7 @@ pub struct ObjectConfig {
     /// Sliding friction of the object against the finger, replacing the model's value on the grip
     /// (`object_grip`, the only part the finger and palm touch; the base keeps its table friction).
     pub friction: Option<f64>,
-    /// Where the object's footprint centre stands on the table, world x and y [m]. `None`: right under
+    /// Where the object's footprint centre stands on the table, world x and y \[m\]. `None`: right under
     /// the gripper's wrap in the start pose (the scene starts at the grasp).
     pub position_m: Option<[f64; 2]>,
 }
@@ -504,7 +504,7 @@ impl Validate for ObjectConfig {
 }
 
 impl ObjectName {
-    /// Radius of the grip capsule the finger wraps [m] (models/objects/*.xml, `object_grip`).
+    /// Radius of the grip capsule the finger wraps \[m\] (models/objects/*.xml, `object_grip`).
     pub fn grip_radius_m(self) -> f64 {
         match self {
             ObjectName::Crimper => 0.0125,
@@ -514,7 +514,7 @@ impl ObjectName {
     }
 
     /// Height above the object's footprint at which the strip leaves the guide and starts its first
-    /// turn [m]; the helix rises from there, along the grip capsule (models/objects/*.xml).
+    /// turn \[m\]; the helix rises from there, along the grip capsule (models/objects/*.xml).
     pub fn grip_height_m(self) -> f64 {
         match self {
             ObjectName::Crimper => 0.1,

@@ -29,9 +29,9 @@ pub struct Drive {
 /// The setpoints for one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepSetpoints {
-    /// Growth and twine servo setpoints [m].
+    /// Growth and twine servo setpoints \[m\].
     pub motors: [f64; 2],
-    /// Kinematic arm angles at the end of the step [rad].
+    /// Kinematic arm angles at the end of the step \[rad\].
     pub arm_q: [f64; 6],
 }
 
@@ -52,7 +52,7 @@ impl Drive {
         }
     }
 
-    /// Commands the finger growth [m], clamped to 0..finger.length_m.
+    /// Commands the finger growth \[m\], clamped to 0..finger.length_m.
     pub fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
         if !growth_m.is_finite() {
             return Err(PhysicsError::BadInput { what: "growth", value: growth_m });
@@ -61,7 +61,7 @@ impl Drive {
         Ok(())
     }
 
-    /// Commands the tendon wound in [m], clamped to 0..finger.twine_max_m.
+    /// Commands the tendon wound in \[m\], clamped to 0..finger.twine_max_m.
     pub fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError> {
         if !twine_m.is_finite() {
             return Err(PhysicsError::BadInput { what: "twine", value: twine_m });
@@ -70,7 +70,7 @@ impl Drive {
         Ok(())
     }
 
-    /// Commands the arm joint targets [rad] at simulated time `now_s`.
+    /// Commands the arm joint targets \[rad\] at simulated time `now_s`.
     pub fn set_arm_target(&mut self, q: [f64; 6], now_s: f64) -> Result<(), PhysicsError> {
         if let Some(v) = q.iter().find(|v| !v.is_finite()) {
             return Err(PhysicsError::BadInput { what: "arm target", value: *v });
@@ -81,17 +81,17 @@ impl Drive {
         Ok(())
     }
 
-    /// The arm target last commanded [rad].
+    /// The arm target last commanded \[rad\].
     pub fn arm_target(&self) -> [f64; 6] {
         self.arm_target
     }
 
-    /// The kinematic arm's current angles [rad].
+    /// The kinematic arm's current angles \[rad\].
     pub fn arm_q(&self) -> [f64; 6] {
         self.arm_q
     }
 
-    /// The twine servo's current setpoint [m].
+    /// The twine servo's current setpoint \[m\].
     pub fn twine_setpoint_m(&self) -> f64 {
         self.motor_setpoint[1]
     }
@@ -123,7 +123,7 @@ impl Drive {
 /// The object's grip centre seen from the hand.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GripInHand {
-    /// Grip centre in the hand frame [m].
+    /// Grip centre in the hand frame \[m\].
     pub position_m: [f64; 3],
     /// Speed of the grip centre relative to the hand point it coincides with [m/s].
     pub slip_speed_m_s: f64,

@@ -32,18 +32,18 @@ pub use scene::{PhysicsReadout, Scene, SceneModel};
 pub trait Physics: Send {
     /// The engine.
     fn backend(&self) -> Backend;
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     fn time(&self) -> f64;
-    /// Step size [s].
+    /// Step size \[s\].
     fn timestep(&self) -> f64;
-    /// Commands the finger growth (strip length out of the guide) [m], clamped to 0..finger.length_m.
+    /// Commands the finger growth (strip length out of the guide) \[m\], clamped to 0..finger.length_m.
     /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
     fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError>;
     /// Commands the twine motor: metres of tendon wound in (the twining/curl input, the PID's output),
     /// clamped to 0..finger.twine_max_m. More twine curls the strip tighter and raises the grip force.
     /// The servo's setpoint follows at most at `finger.motor_max_speed_m_s`.
     fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError>;
-    /// Commands the arm joint targets [rad]. Dynamic mode: the position servos' setpoints. Kinematic
+    /// Commands the arm joint targets \[rad\]. Dynamic mode: the position servos' setpoints. Kinematic
     /// mode: the arm moves towards them at most at `physics.arm_max_speed_rad_s` per joint, and the hand
     /// follows the flange pose from forward kinematics.
     fn set_arm_target(&mut self, q: [f64; 6]) -> Result<(), PhysicsError>;
@@ -84,7 +84,7 @@ pub struct SceneSpec {
     pub finger: FingerConfig,
     /// The object (and with it the table); `None` for a finger-only scene.
     pub object: Option<ObjectConfig>,
-    /// Start joint angles of the arm [rad]. The object is placed where the grown finger wraps it in
+    /// Start joint angles of the arm \[rad\]. The object is placed where the grown finger wraps it in
     /// this pose (see [`compose::placement`]).
     pub arm_q0: [f64; 6],
 }
@@ -164,7 +164,7 @@ pub enum PhysicsError {
     /// The simulation diverged.
     #[error("simulation diverged at t = {time_s:.4} s: {cause}")]
     Diverged {
-        /// Simulated time of the step that diverged [s].
+        /// Simulated time of the step that diverged \[s\].
         time_s: f64,
         /// What was detected.
         cause: Divergence,
@@ -189,7 +189,7 @@ pub enum Divergence {
     /// A contact is deeper than `physics.max_penetration_m`.
     #[error("contact {depth_m:.4} m deep between `{geom1}` and `{geom2}`")]
     Penetration {
-        /// Penetration depth [m].
+        /// Penetration depth \[m\].
         depth_m: f64,
         /// First geom.
         geom1: String,
@@ -199,7 +199,7 @@ pub enum Divergence {
     /// Kinetic energy beyond `physics.max_kinetic_energy_j`.
     #[error("kinetic energy {joules:.3e} J beyond the bound")]
     Energy {
-        /// Kinetic energy [J].
+        /// Kinetic energy \[J\].
         joules: f64,
     },
 }

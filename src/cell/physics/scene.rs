@@ -192,43 +192,43 @@ impl SceneModel {
 /// What the physics reports after a step (SI units, world frame).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PhysicsReadout {
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub time_s: f64,
-    /// Normal force of the object on the sensor pad (casing and bump) [N]: the FBG sensor's input.
+    /// Normal force of the object on the sensor pad (casing and bump) \[N\]: the FBG sensor's input.
     pub pad_force_n: f64,
-    /// Sum of the normal forces between the object and the whole finger, pad included [N].
+    /// Sum of the normal forces between the object and the whole finger, pad included \[N\].
     pub grip_force_n: f64,
-    /// Normal force between the object and the palm beside the guide exit [N] (not part of the grip
+    /// Normal force between the object and the palm beside the guide exit \[N\] (not part of the grip
     /// force: the palm is the hand, not the finger).
     pub palm_force_n: f64,
     /// Number of active object-finger contacts.
     pub grip_contacts: usize,
     /// Whether the object touches the finger at all.
     pub touching: bool,
-    /// Object body origin (footprint centre) [m].
+    /// Object body origin (footprint centre) \[m\].
     pub object_pos_m: [f64; 3],
     /// Object orientation (w, x, y, z).
     pub object_quat: [f64; 4],
     /// Linear velocity of the object's grip centre (the middle of the wrapped handle or neck) [m/s].
     pub object_vel_m_s: [f64; 3],
-    /// The object's grip centre expressed in the hand frame [m]: its change is the slip distance (hand z
+    /// The object's grip centre expressed in the hand frame \[m\]: its change is the slip distance (hand z
     /// points down in the pick pose, so a falling object's z grows).
     pub object_in_hand_m: [f64; 3],
     /// Speed of the object's grip centre relative to the hand point it coincides with [m/s].
     pub slip_speed_m_s: f64,
-    /// Hand (flange) position [m].
+    /// Hand (flange) position \[m\].
     pub hand_pos_m: [f64; 3],
-    /// Finger growth out of the guide [m] (actual motor position).
+    /// Finger growth out of the guide \[m\] (actual motor position).
     pub growth_m: f64,
-    /// Tendon wound in by the twine motor [m] (actual motor position).
+    /// Tendon wound in by the twine motor \[m\] (actual motor position).
     pub twine_m: f64,
-    /// The twine servo's current setpoint [m] (the command after the motor speed limit).
+    /// The twine servo's current setpoint \[m\] (the command after the motor speed limit).
     pub twine_setpoint_m: f64,
-    /// Creep elongation of the Maxwell branch [m].
+    /// Creep elongation of the Maxwell branch \[m\].
     pub creep_m: f64,
-    /// Tendon tension, both branches [N].
+    /// Tendon tension, both branches \[N\].
     pub tendon_tension_n: f64,
-    /// Arm joint angles [rad] (kinematic mode: the rate-limited commanded angles).
+    /// Arm joint angles \[rad\] (kinematic mode: the rate-limited commanded angles).
     pub arm_q: [f64; 6],
 }
 
@@ -333,7 +333,7 @@ impl Scene {
         Ok(())
     }
 
-    /// Normal force [N] summed over contacts between a geom in `a` and a geom in `b`, and their count.
+    /// Normal force \[N\] summed over contacts between a geom in `a` and a geom in `b`, and their count.
     pub fn normal_force_between(&self, a: &[usize], b: &[usize]) -> (f64, usize) {
         let mut sum = 0.0;
         let mut n = 0;
@@ -348,12 +348,12 @@ impl Scene {
         (sum, n)
     }
 
-    /// The pad's normal force as MuJoCo's `touch` sensor on `pad_site` reports it [N].
+    /// The pad's normal force as MuJoCo's `touch` sensor on `pad_site` reports it \[N\].
     pub fn pad_touch_sensor_n(&self) -> f64 {
         self.data.sensordata()[self.shared.ids.pad_touch_adr]
     }
 
-    /// Tension of the tendon path [N]: both standard-linear-solid branches (zero when slack).
+    /// Tension of the tendon path \[N\]: both standard-linear-solid branches (zero when slack).
     pub fn tendon_tension_n(&self) -> f64 {
         let ids = &self.shared.ids;
         let m = &self.shared.model;

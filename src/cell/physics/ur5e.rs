@@ -3,14 +3,14 @@
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
 
-/// DH d [m] (Universal Robots, "DH Parameters for calculations of kinematics and dynamics").
+/// DH d \[m\] (Universal Robots, "DH Parameters for calculations of kinematics and dynamics").
 pub const D: [f64; 6] = [0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996];
-/// DH a [m].
+/// DH a \[m\].
 pub const A: [f64; 6] = [0.0, -0.425, -0.3922, 0.0, 0.0, 0.0];
-/// DH alpha [rad].
+/// DH alpha \[rad\].
 pub const ALPHA: [f64; 6] =
     [std::f64::consts::FRAC_PI_2, 0.0, 0.0, std::f64::consts::FRAC_PI_2, -std::f64::consts::FRAC_PI_2, 0.0];
-/// A commonly used home pose [rad] (hardware.md): tool flange pointing down.
+/// A commonly used home pose \[rad\] (hardware.md): tool flange pointing down.
 pub const HOME: [f64; 6] = [
     -std::f64::consts::FRAC_PI_2,
     -std::f64::consts::FRAC_PI_2,
@@ -20,7 +20,7 @@ pub const HOME: [f64; 6] = [
     0.0,
 ];
 
-/// Pose of the tool flange in the base frame for joint angles `q` [rad]:
+/// Pose of the tool flange in the base frame for joint angles `q` \[rad\]:
 /// the product of Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i).
 pub fn forward(q: &[f64; 6]) -> Isometry3<f64> {
     let mut t = Isometry3::identity();

@@ -29,7 +29,7 @@ pub fn slope(p: &PhysicsConfig, angle_rad: f64) -> Result<MjModel, PhysicsError>
 }
 
 /// Two pads on a carriage (slide joint `lift`) squeezing a 0.35 kg box with friction `mu` on every geom;
-/// actuators `squeeze_l`, `squeeze_r` are the pads' normal forces [N].
+/// actuators `squeeze_l`, `squeeze_r` are the pads' normal forces \[N\].
 pub fn pinch(p: &PhysicsConfig, mu: f64) -> Result<MjModel, PhysicsError> {
     compile(PINCH, &[("header", header(p)), ("mu", num(mu))])
 }
@@ -87,7 +87,7 @@ impl ValidationRun {
         Ok(())
     }
 
-    /// World position of the named body's origin [m].
+    /// World position of the named body's origin \[m\].
     pub fn body_position(&self, body: &str) -> Result<[f64; 3], PhysicsError> {
         let b = self.id(mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_BODY, body)?;
         Ok(match &self.engine {
@@ -96,7 +96,7 @@ impl ValidationRun {
         })
     }
 
-    /// Sum of the contact normal forces on the named geom [N].
+    /// Sum of the contact normal forces on the named geom \[N\].
     pub fn normal_force_on(&self, geom: &str) -> Result<f64, PhysicsError> {
         let g = self.id(mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_GEOM, geom)?;
         Ok(match &self.engine {

@@ -61,13 +61,13 @@ pub struct RealCellConfig {
     pub stream_port: u16,
     /// Motor IDs, bus speed, FBG windows (the scenario's `[hardware]`).
     pub hardware: HardwareConfig,
-    /// Interrogator sample period [s] (1 kHz on the si255, hardware.md).
+    /// Interrogator sample period \[s\] (1 kHz on the si255, hardware.md).
     pub sensor_period_s: f64,
     /// Watchdog: the sensor sample may be this many periods old before the cell stops [-].
     /// 5: a few lost samples are tolerated, a stalled stream stops the arm within 5 ms at 1 kHz
     /// plus one control tick.
     pub sensor_stale_samples: f64,
-    /// Watchdog on the RTDE stream [s]: 5 periods at 500 Hz.
+    /// Watchdog on the RTDE stream \[s\]: 5 periods at 500 Hz.
     pub arm_stale_s: f64,
     /// Longest wait for a motor's reply ([`super::dxl::REPLY_TIMEOUT`], 50 ms), and the watchdog
     /// on the motors' positions: older than this, the cell stops.

@@ -33,7 +33,7 @@ pub struct HardwareConfig {
     /// a sync read of both motors take about 6 ms of wire time at 57 600: run a 500 Hz loop at
     /// 1 M or more (set the motors' Baud Rate first).
     pub dxl_baud: u32,
-    /// Which interrogator channel and wavelength windows hold FBG1 and FBG2 [nm].
+    /// Which interrogator channel and wavelength windows hold FBG1 and FBG2 \[nm\].
     pub fbg: FbgWindows,
 }
 

@@ -18,7 +18,7 @@ use std::time::Instant;
 /// Motor positions [growth, twine] in rad and when their sync read was put on the bus.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MotorSample {
-    /// Angles from the set-up position [rad].
+    /// Angles from the set-up position \[rad\].
     pub rad: [f64; 2],
     /// When the request for them was sent.
     pub requested_at: Instant,

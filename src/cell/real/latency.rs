@@ -13,18 +13,18 @@ use std::time::{Duration, Instant};
 pub struct LatencyReport {
     /// Ticks measured.
     pub ticks: usize,
-    /// Median latency [s].
+    /// Median latency \[s\].
     pub p50_s: f64,
-    /// 99th percentile [s].
+    /// 99th percentile \[s\].
     pub p99_s: f64,
-    /// Largest [s].
+    /// Largest \[s\].
     pub max_s: f64,
     /// Ticks whose read → write finished after the next tick's deadline.
     pub missed_deadlines: usize,
     /// Runs of consecutive missed deadlines: one stall of the thread makes the ticks behind it
     /// late too, so this counts the stalls.
     pub missed_runs: usize,
-    /// 99th percentile of the read → write time alone, without the wake-up lateness [s].
+    /// 99th percentile of the read → write time alone, without the wake-up lateness \[s\].
     pub work_p99_s: f64,
 }
 

@@ -19,7 +19,7 @@ pub struct SafetyLimits {
     pub max_speed_rad_s: f64,
     /// Largest joint acceleration [rad/s²].
     pub max_accel_rad_s2: f64,
-    /// Force ceiling [N]; below the sensor's range so the reading is still meaningful.
+    /// Force ceiling \[N\]; below the sensor's range so the reading is still meaningful.
     pub max_force_n: f64,
     /// Calibration for the ceiling's force estimate.
     pub calibration: ForceCalibration,

@@ -17,7 +17,7 @@ use tokio::net::tcp::OwnedWriteHalf;
 pub const OUTPUT_NAMES: [&str; 7] =
     ["timestamp", "actual_q", "actual_qd", "actual_TCP_pose", "robot_mode", "safety_mode", "runtime_state"];
 
-/// RTDE output rate [Hz]: the e-Series maximum.
+/// RTDE output rate \[Hz\]: the e-Series maximum.
 pub const OUTPUT_RATE_HZ: f64 = 500.0;
 
 /// Input bytes the socket may hold back before the controller counts as not reading: about 30
@@ -30,9 +30,9 @@ const SETUP_TIMEOUT: Duration = Duration::from_secs(3);
 /// One decoded output package.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArmSample {
-    /// Controller time [s].
+    /// Controller time \[s\].
     pub timestamp_s: f64,
-    /// Joint positions [rad].
+    /// Joint positions \[rad\].
     pub q: [f64; 6],
     /// Joint velocities [rad/s].
     pub qd: [f64; 6],
@@ -112,7 +112,7 @@ impl UrClient {
         Ok(UrClient { session, writer, input_recipe, unsent: Vec::with_capacity(MAX_UNSENT), feed, reader })
     }
 
-    /// Writes the six targets [rad] and the enable flag in one data package and waits until the
+    /// Writes the six targets \[rad\] and the enable flag in one data package and waits until the
     /// socket took it (and anything held back before it).
     pub async fn send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
         self.queue(q, enable)?;
@@ -122,7 +122,7 @@ impl UrClient {
     }
 
     /// Writes the package without waiting: what the socket does not take now is held back and
-    /// goes first next time. Fails if the controller stops reading (more than [`MAX_UNSENT`] bytes
+    /// goes first next time. Fails if the controller stops reading (more than 2 KiB
     /// held back) or the connection broke.
     pub fn try_send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
         self.queue(q, enable)?;

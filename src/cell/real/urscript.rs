@@ -2,7 +2,7 @@
 //!
 //! The program (`urscript/follow.script`, written by this project) loops forever:
 //! - `input_int_register_24` = 1: read the six joint targets from `input_double_register_24..29`
-//!   [rad] and `servoj` to them over 2 ms (one RTDE period at 500 Hz), `output_int_register_24` = 1;
+//!   \[rad\] and `servoj` to them over 2 ms (one RTDE period at 500 Hz), `output_int_register_24` = 1;
 //! - anything else: `stopj(2.0)` (2 rad/s² deceleration), `output_int_register_24` = 0.
 //!
 //! Registers 24..29 leave 0..23 free for SDU's `ur_rtde`, whose control script uses the lower half.

@@ -98,12 +98,12 @@ pub struct RapierWorld {
 }
 
 impl RapierWorld {
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub fn time(&self) -> f64 {
         self.time_s
     }
 
-    /// Step size [s].
+    /// Step size \[s\].
     pub fn timestep(&self) -> f64 {
         self.world.integration_parameters.dt
     }
@@ -179,7 +179,7 @@ impl RapierWorld {
         Some(self.world.colliders.get(self.colliders.get(g).copied()??)?.position().translation)
     }
 
-    /// Normal force [N] summed over contacts between a geom in `a` and a geom in `b`, and the
+    /// Normal force \[N\] summed over contacts between a geom in `a` and a geom in `b`, and the
     /// number of contact points carrying force.
     pub fn normal_force_between(&self, a: &[usize], b: &[usize]) -> (f64, usize) {
         let dt = self.timestep();
@@ -204,7 +204,7 @@ impl RapierWorld {
         (sum, n)
     }
 
-    /// Tension of tendon `t` [N]: MuJoCo's tendon force, positive when the tendon is shorter than
+    /// Tension of tendon `t` \[N\]: MuJoCo's tendon force, positive when the tendon is shorter than
     /// its dead band (wound in) and pulls.
     pub fn tendon_tension(&self, t: usize) -> f64 {
         self.tendon_force(&self.tendons[t])

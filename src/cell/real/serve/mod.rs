@@ -1,4 +1,4 @@
-//! Virtual devices: the twin ([`SimCell`] stepped in real time) behind the real protocols.
+//! Virtual devices: the twin ([`crate::cell::sim::SimCell`] stepped in real time) behind the real protocols.
 //!
 //! - RTDE on `rtde_port` (30004) and the URScript secondary interface on `script_port` (30002): the
 //!   virtual controller "runs" an uploaded program by doing what `follow.script` does (follow
@@ -41,7 +41,7 @@ pub struct ServeConfig {
     pub command_port: u16,
     /// HYPERION peak stream port.
     pub stream_port: u16,
-    /// Twin tick [s]: the RTDE output and peak stream period. 1 ms = the si255's 1 kHz scan rate.
+    /// Twin tick \[s\]: the RTDE output and peak stream period. 1 ms = the si255's 1 kHz scan rate.
     pub period_s: f64,
     /// Scheduling of the twin, bus and network threads (default: normal). The virtual devices
     /// stand in for dedicated hardware; on a shared machine a `SCHED_FIFO` priority keeps them from

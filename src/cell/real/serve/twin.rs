@@ -22,11 +22,11 @@ use std::time::{Duration, Instant};
 /// What the twin last computed (for tests and the serve printout).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwinStatus {
-    /// Twin time [s].
+    /// Twin time \[s\].
     pub time_s: f64,
-    /// Arm joints [rad].
+    /// Arm joints \[rad\].
     pub arm_q: [f64; ARM_JOINTS],
-    /// Growth, twine motor angles [rad].
+    /// Growth, twine motor angles \[rad\].
     pub motors_rad: [f64; 2],
     /// Latest interrogator sample.
     pub wavelengths: Wavelengths,
