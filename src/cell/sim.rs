@@ -64,6 +64,20 @@ pub struct SimCell {
 }
 
 impl SimCell {
+    /// Commands the growth and twine motors [rad] only. The arm's command stays as it is, and with
+    /// it the interval over which the kinematic arm moves to its target (the time between two arm
+    /// commands): for a caller that updates the motors more often than arm targets arrive, as the
+    /// virtual devices do.
+    pub fn write_motors(&mut self, growth_motor_rad: f64, twine_motor_rad: f64) -> Result<(), CellError> {
+        require_state(self.lifecycle, Lifecycle::Active, "write")?;
+        let growth = self.gripper.growth_length_m(growth_motor_rad);
+        let twine = self.gripper.tendon_pull_m(twine_motor_rad);
+        let scene = self.scene.as_mut().expect("active implies configured");
+        scene.set_growth(growth).map_err(Self::physics_error)?;
+        scene.set_twine(twine).map_err(Self::physics_error)?;
+        Ok(())
+    }
+
     /// A cell over a compiled scene model (shareable between runs). Nothing is simulated until
     /// [`Cell::configure`].
     pub fn new(
@@ -175,13 +189,9 @@ impl Cell for SimCell {
 
     fn write(&mut self, c: &CellCommand) -> Result<(), CellError> {
         require_state(self.lifecycle, Lifecycle::Active, "write")?;
-        let growth = self.gripper.growth_length_m(c.growth_motor_rad);
-        let twine = self.gripper.tendon_pull_m(c.twine_motor_rad);
         let scene = self.scene.as_mut().expect("active implies configured");
         scene.set_arm_target(c.arm_q).map_err(Self::physics_error)?;
-        scene.set_growth(growth).map_err(Self::physics_error)?;
-        scene.set_twine(twine).map_err(Self::physics_error)?;
-        Ok(())
+        self.write_motors(c.growth_motor_rad, c.twine_motor_rad)
     }
 
     fn wait_until(&mut self, time_s: f64) -> Result<(), CellError> {

@@ -2,23 +2,30 @@
 //! in the real-path tests, whether the runs come from memory or from `trace.csv`.
 //!
 //! Tolerances: the real path's timing jitters (ticks land a fraction of a millisecond late, the
-//! twin steps on its own clock), so traces are not identical; phase medians of the force estimate
-//! must agree within 0.1 N (a sixth of the 0.6 N setpoint, about 40 times the sensor's 2.6 mN
-//! resolution) while the arm stands still, within 0.2 N (a third of the setpoint) during the lift,
-//! and phase durations within 0.2 s. The lift is looser because the moment the object's weight
-//! comes off the table, and the force transient after it, move with the tick timing: on an idle
-//! machine the medians agree within 5 mN, on a loaded 2-core machine they were seen 0.10 N apart.
-//! Means are not compared: the lift has force spikes of several newtons as the object shifts in
-//! the hand, whose timing the real path's jitter moves; the median is what the hand holds with.
+//! twin steps on its own clock), so traces are not identical; per phase, the median and the 5th
+//! and 95th percentiles of the force estimate must agree within 0.1 N (a sixth of the 0.6 N
+//! setpoint, about 40 times the sensor's 2.6 mN resolution) while the finger grows and wraps,
+//! within 0.2 N (a third of the setpoint) in the grasp and the lift, and phase durations within
+//! 0.2 s. Those two are transients whose course moves with the tick timing: in the grasp the coil
+//! can seat in one of two ways (the commands reach the twin's 5 ms physics steps at whatever phase
+//! the two clocks have; the second way was seen in 2 of 14 runs, one of them with both cores loaded, with the
+//! grasp's median at 0.50-0.54 N against 0.41 N and its 95th percentile 0.17 N higher, while the
+//! lift that follows agrees within 0.02 N); in the lift, the moment the object's weight comes off
+//! the table and the force transient after it (medians seen 0.10 N apart on a loaded 2-core
+//! machine, within 5 mN on an idle one). The percentiles catch a grip that shakes:
+//! when the virtual arm still jumped to each streamed target, the lift's force swung between
+//! 0.15 N and the sensor's 4.6 N limit (5th-95th percentiles 0.15-2.2 N against the simulated
+//! run's 0.56-0.66 N) while its median stayed within 0.05 N. Means and extremes are not compared:
+//! single spikes move with the jitter.
 
 use tendril::run::runner::RunReport;
 
 /// The phases the short grasp-hold-lift goes through, in order.
 pub const PHASES: [&str; 4] = ["grow", "wrap", "grasp", "lift"];
 
-/// Median force estimate tolerance [N] in `phase`.
+/// Tolerance [N] on the force estimate's percentiles in `phase`.
 pub fn force_tolerance_n(phase: &str) -> f64 {
-    if phase == "lift" { 0.2 } else { 0.1 }
+    if matches!(phase, "grasp" | "lift") { 0.2 } else { 0.1 }
 }
 
 /// Phase duration tolerance [s].
@@ -59,31 +66,46 @@ pub fn from_trace_csv(path: &std::path::Path) -> Vec<Tick> {
         .collect()
 }
 
-/// Median force estimate [N] and duration [s] of `phase`.
-pub fn phase_stats(ticks: &[Tick], phase: &str) -> (f64, f64) {
+/// What is compared of one phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseStats {
+    /// 5th percentile, median and 95th percentile of the force estimate [N].
+    pub force_n: [f64; 3],
+    /// Duration [s].
+    pub duration_s: f64,
+}
+
+/// The percentiles compared, with their names.
+const PERCENTILES: [(f64, &str); 3] = [(0.05, "5th percentile"), (0.5, "median"), (0.95, "95th percentile")];
+
+/// Force percentiles and duration of `phase`.
+pub fn phase_stats(ticks: &[Tick], phase: &str) -> PhaseStats {
     let rows: Vec<&Tick> = ticks.iter().filter(|t| t.phase == phase).collect();
     assert!(!rows.is_empty(), "no {phase} rows");
     let mut forces: Vec<f64> = rows.iter().map(|t| t.force_n).collect();
     forces.sort_by(f64::total_cmp);
-    let median = forces[forces.len() / 2];
-    (median, rows[rows.len() - 1].time_s - rows[0].time_s)
+    let at = |p: f64| forces[((forces.len() - 1) as f64 * p).round() as usize];
+    PhaseStats { force_n: PERCENTILES.map(|(p, _)| at(p)), duration_s: rows[rows.len() - 1].time_s - rows[0].time_s }
 }
 
-/// Every phase of [`PHASES`] reached on the real path, its median force and duration within the
-/// tolerances of the simulated run's; prints the figures.
+/// Every phase of [`PHASES`] reached on the real path, its force percentiles and duration within
+/// the tolerances of the simulated run's; prints the figures.
 pub fn assert_phases_agree(sim: &[Tick], real: &[Tick]) {
     for phase in PHASES {
         assert!(real.iter().any(|t| t.phase == phase), "real run never reached {phase}");
-        let (f_sim, d_sim) = phase_stats(sim, phase);
-        let (f_real, d_real) = phase_stats(real, phase);
+        let (s, r) = (phase_stats(sim, phase), phase_stats(real, phase));
+        let (d_sim, d_real) = (s.duration_s, r.duration_s);
         eprintln!(
-            "{phase}: median force sim {f_sim:.3} N real {f_real:.3} N; duration sim {d_sim:.2} s real {d_real:.2} s"
+            "{phase}: force 5/50/95 % sim {:.3?} N real {:.3?} N; duration sim {d_sim:.2} s real {d_real:.2} s",
+            s.force_n, r.force_n
         );
         let tolerance_n = force_tolerance_n(phase);
-        assert!(
-            (f_sim - f_real).abs() < tolerance_n,
-            "{phase}: median force sim {f_sim:.3} N, real {f_real:.3} N (tolerance {tolerance_n} N)"
-        );
+        for ((f_sim, f_real), (_, name)) in s.force_n.into_iter().zip(r.force_n).zip(PERCENTILES) {
+            assert!(
+                (f_sim - f_real).abs() < tolerance_n,
+                "{phase}: force {name} sim {f_sim:.3} N, real {f_real:.3} N (tolerance {tolerance_n} N)"
+            );
+        }
         assert!(
             (d_sim - d_real).abs() < DURATION_TOLERANCE_S,
             "{phase}: duration sim {d_sim:.2} s, real {d_real:.2} s (tolerance {DURATION_TOLERANCE_S} s)"

@@ -173,17 +173,23 @@ pub fn spawn(
             s.outputs.actual_q = first.arm_q;
             s.outputs.target_q = first.arm_q;
         }
+        let mut packages_seen = 0;
         let started = Instant::now();
         for k in 1u64.. {
             if stop.load(Ordering::SeqCst) {
                 return Ok(());
             }
-            {
+            let new_arm_target = {
                 let s = lock(&state);
                 let regs = &s.inputs.values;
                 let following = s.program_loaded && regs.int_registers[ENABLE_REGISTER] == 1;
                 let targets: [f64; ARM_JOINTS] = std::array::from_fn(|j| regs.double_registers[TARGET_REGISTER + j]);
-                if following && targets.iter().all(|v| v.is_finite()) {
+                // A target is new when a package came in: the arm then moves to it over the time
+                // since the one before, the client's cadence, as the simulated path's arm does.
+                let arrived = s.inputs.packages != packages_seen;
+                packages_seen = s.inputs.packages;
+                let new = following && arrived && targets.iter().all(|v| v.is_finite());
+                if new {
                     command.arm_q = targets;
                 }
                 for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
@@ -194,8 +200,13 @@ pub fn spawn(
                         *slot = ticks_to_rad(t.goal_position());
                     }
                 }
+                new
+            };
+            if new_arm_target {
+                cell.write(&command).map_err(e)?;
+            } else {
+                cell.write_motors(command.growth_motor_rad, command.twine_motor_rad).map_err(e)?;
             }
-            cell.write(&command).map_err(e)?;
             cell.wait_until(k as f64 * period_s).map_err(e)?;
             let r = cell.read().map_err(e)?;
             let truth = cell.ground_truth().unwrap_or_default();

@@ -48,6 +48,9 @@ impl Default for ServerConfig {
 pub struct SharedInputs {
     /// Current input values (the motion program reads them).
     pub values: RobotInputs,
+    /// Input data packages applied so far, over all connections: the cadence at which a client
+    /// streams its targets.
+    pub packages: u64,
     owners: HashMap<String, u64>,
 }
 
@@ -231,6 +234,7 @@ impl ServerSession {
         for (name, value) in recipe.names.iter().zip(values) {
             shared.values.apply(name, value);
         }
+        shared.packages += 1;
         Ok(())
     }
 

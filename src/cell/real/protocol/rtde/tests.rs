@@ -137,6 +137,7 @@ fn client_and_server_sessions_talk() {
     assert!(exchange(p, &mut client, &mut server).is_empty());
     assert_eq!(shared.values.double_registers[0], 0.25);
     assert_eq!(shared.values.int_registers[1], 42);
+    assert_eq!(shared.packages, 1, "each input package is counted (the arm's command cadence)");
 
     let outputs = RobotOutputs { timestamp_s: 1.25, ..RobotOutputs::default() };
     let mut to_client: Vec<u8> = Vec::new();
