@@ -64,7 +64,7 @@ pub struct SimCell {
 }
 
 impl SimCell {
-    /// Commands the growth and twine motors [rad] only. The arm's command stays as it is, and with
+    /// Commands the growth and twine motors \[rad\] only. The arm's command stays as it is, and with
     /// it the interval over which the kinematic arm moves to its target (the time between two arm
     /// commands): for a caller that updates the motors more often than arm targets arrive, as the
     /// virtual devices do.

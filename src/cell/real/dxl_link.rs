@@ -123,21 +123,21 @@ impl GripperLink {
 
     /// Stops the IO thread (after the transfer under way) and gives the bus back.
     pub fn stop(mut self) -> Result<GripperBus, String> {
-        let (m, wake) = &*self.shared;
-        lock(m).stop = true;
-        wake.notify_one();
-        let thread = self.thread.take().expect("taken only here");
-        thread.join().map_err(|_| "Dynamixel: IO thread panicked".to_string())
+        self.shutdown().unwrap_or_else(|| Err("Dynamixel: IO thread already stopped".into()))
+    }
+
+    /// Stops and joins the IO thread, if it still runs.
+    fn shutdown(&mut self) -> Option<Result<GripperBus, String>> {
+        let thread = self.thread.take()?;
+        lock(&self.shared.0).stop = true;
+        self.shared.1.notify_one();
+        Some(thread.join().map_err(|_| "Dynamixel: IO thread panicked".to_string()))
     }
 }
 
 impl Drop for GripperLink {
     fn drop(&mut self) {
-        if let Some(thread) = self.thread.take() {
-            lock(&self.shared.0).stop = true;
-            self.shared.1.notify_one();
-            let _ = thread.join();
-        }
+        let _ = self.shutdown();
     }
 }
 
