@@ -5,18 +5,18 @@
 //! twin steps on its own clock), so traces are not identical; per phase, the median and the 5th
 //! and 95th percentiles of the force estimate must agree within 0.1 N (a sixth of the 0.6 N
 //! setpoint, about 40 times the sensor's 2.6 mN resolution) while the finger grows and wraps,
-//! within 0.2 N (a third of the setpoint) in the grasp and the lift, and phase durations within
-//! 0.2 s. Those two are transients whose course moves with the tick timing: in the grasp the coil
-//! can seat in one of two ways (the commands reach the twin's 5 ms physics steps at whatever phase
-//! the two clocks have; the second way was seen in 2 of 14 runs, one of them with both cores loaded, with the
-//! grasp's median at 0.50-0.54 N against 0.41 N and its 95th percentile 0.17 N higher, while the
-//! lift that follows agrees within 0.02 N); in the lift, the moment the object's weight comes off
-//! the table and the force transient after it (medians seen 0.10 N apart on a loaded 2-core
-//! machine, within 5 mN on an idle one). The percentiles catch a grip that shakes:
-//! when the virtual arm still jumped to each streamed target, the lift's force swung between
-//! 0.15 N and the sensor's 4.6 N limit (5th-95th percentiles 0.15-2.2 N against the simulated
-//! run's 0.56-0.66 N) while its median stayed within 0.05 N. Means and extremes are not compared:
-//! single spikes move with the jitter.
+//! within 0.25 N in the grasp and 0.2 N (a third of the setpoint) in the lift, and phase durations
+//! within 0.2 s. Those two are transients whose course moves with the tick timing. In the grasp
+//! the coil can seat in one of two ways (the commands reach the twin's 5 ms physics steps at
+//! whatever phase the two clocks have): the second way was seen in 1 of 15 runs on an idle machine
+//! and 5 of 13 with both cores loaded, with the grasp's median at 0.50-0.54 N against 0.41 N and
+//! its 95th percentile up to 0.175 N higher, while the lift that follows agreed within 0.05 N. In
+//! the lift, the moment the object's weight comes off the table and the force transient after it
+//! move (medians seen 0.10 N apart on a loaded 2-core machine, within 5 mN on an idle one). The
+//! percentiles catch a grip that shakes: when the virtual arm still jumped to each streamed
+//! target, the lift's force swung between 0.15 N and the sensor's 4.6 N limit (5th-95th
+//! percentiles 0.15-2.2 N against the simulated run's 0.56-0.66 N) while its median stayed within
+//! 0.05 N. Means and extremes are not compared: single spikes move with the jitter.
 
 use tendril::run::runner::RunReport;
 
@@ -25,7 +25,11 @@ pub const PHASES: [&str; 4] = ["grow", "wrap", "grasp", "lift"];
 
 /// Tolerance [N] on the force estimate's percentiles in `phase`.
 pub fn force_tolerance_n(phase: &str) -> f64 {
-    if matches!(phase, "grasp" | "lift") { 0.2 } else { 0.1 }
+    match phase {
+        "grasp" => 0.25,
+        "lift" => 0.2,
+        _ => 0.1,
+    }
 }
 
 /// Phase duration tolerance [s].
