@@ -2,13 +2,16 @@
 
 use std::process::{Command, Output};
 
+/// `tendril` as a command to give arguments to and start, in the project's folder.
+pub fn tendril_command() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tendril"));
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
 /// Runs `tendril ARGS` in the project's folder and waits for it.
 pub fn tendril(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tendril"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
+    tendril_command().args(args).output().expect("the binary runs")
 }
 
 /// Its standard error as text.

@@ -292,6 +292,7 @@ impl RapierWorld {
     /// Applies generalized force `f` on joint `j` as a wrench pair: on the child body and, opposite,
     /// on the parent at the same point, so no other joint feels it.
     fn apply_generalized(&mut self, j: usize, f: f64) {
+        // `joint_link` written out: it would borrow all of `self`, and the bodies are changed below.
         let Some(link) = self.joints.get(j).and_then(Option::as_ref) else { return };
         let child = *self.world.bodies[link.body].position();
         let axis = child.rotation * link.axis_local;
