@@ -64,9 +64,30 @@ pub fn run_on_cell(
     let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
     let summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
     if let Some(dir) = out {
-        let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
-            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+        write_summary(dir, &summary, scenario)?;
     }
     Ok((summary, report))
+}
+
+/// Writes `summary.json` with the effective scenario under `"effective_scenario"` (every key after the
+/// defaults, the file and the `--set` overrides: what tools read to know the timestep, links,
+/// gains... a run used), and that scenario again as `scenario.toml`, which `tendril run` takes
+/// as it is to repeat the run from its own directory.
+pub fn write_summary(dir: &Path, summary: &RunSummary, scenario: &PickPlaceScenario) -> anyhow::Result<()> {
+    let mut record = serde_json::to_value(summary)?;
+    if let serde_json::Value::Object(fields) = &mut record {
+        fields.insert("effective_scenario".into(), serde_json::to_value(scenario)?);
+    }
+    let path = dir.join("summary.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&record)? + "\n")
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+    let path = dir.join("scenario.toml");
+    let text = toml::to_string(scenario).map_err(|e| anyhow::anyhow!("{}: cannot encode: {e}", path.display()))?;
+    std::fs::write(
+        &path,
+        format!(
+            "# The effective scenario of this run (defaults, file and --set applied): `tendril run` repeats it.\n{text}"
+        ),
+    )
+    .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
 }

@@ -20,10 +20,10 @@ use crate::control::pid::PidConfig;
 use crate::control::slip::SlipConfig;
 use crate::control::task::TaskConfig;
 use crate::scenario::{Checker, Validate};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// A pick-and-place scenario (`scenarios/crimper.toml`, ...).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PickPlaceScenario {
     /// Scenario name, echoed in summaries.
