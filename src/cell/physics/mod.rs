@@ -9,12 +9,14 @@
 //!   model and its run ([`rapier::RapierScene`]).
 //! - [`drive`]: motor speed limits, the kinematic arm's interpolation and the grip-in-hand
 //!   readout, shared by both backends.
+//! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
 //! - [`ur5e`]: DH kinematics.
 
 pub mod check;
 pub mod compose;
 pub mod config;
 pub mod drive;
+pub mod export;
 pub mod rapier;
 pub mod scene;
 pub mod template;
