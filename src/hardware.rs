@@ -56,7 +56,8 @@ pub struct GroundTruth {
     pub sensor_force_n: f64,
     /// Total normal force between finger and object \[N\].
     pub grip_force_n: f64,
-    /// Height of the object's centre of mass above the table top \[m\].
+    /// Height of the object's footprint centre (its body origin) above the table top \[m\]: 0 while it
+    /// stands on the table, the lift once it is carried.
     pub object_height_m: f64,
     /// Speed of the object relative to the hand [m/s].
     pub slip_speed_m_s: f64,

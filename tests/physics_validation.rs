@@ -168,7 +168,7 @@ fn pad_force_equals_mujoco_contact_force_on_the_pad() {
 fn more_twine_gives_more_grip_and_pad_force(backend: Backend) {
     let pad_dip = if backend == Backend::Mujoco { 0.0 } else { 0.2 };
     for name in [ObjectName::Crimper, ObjectName::Hammer, ObjectName::Shampoo] {
-        let spec = SceneSpec { object: Some(ObjectConfig { name, ..ObjectConfig::default() }), ..spec(backend) };
+        let spec = SceneSpec { object: Some(ObjectConfig::named(name)), ..spec(backend) };
         let mut s = SceneModel::build(&spec).unwrap().start().unwrap();
         s.set_growth(spec.finger.length_m).unwrap();
         s.run_for(3.5).unwrap();
@@ -247,12 +247,12 @@ fn a_loose_grip_lets_the_object_slip_out(backend: Backend) {
 fn objects_have_the_papers_masses() {
     // The paper's masses (Sec. V), against what the model files give the compiled scene.
     for (name, paper_kg) in [(ObjectName::Crimper, 0.351), (ObjectName::Hammer, 0.419), (ObjectName::Shampoo, 0.222)] {
-        let spec = SceneSpec { object: Some(ObjectConfig { name, ..ObjectConfig::default() }), ..SceneSpec::default() };
+        let spec = SceneSpec { object: Some(ObjectConfig::named(name)), ..SceneSpec::default() };
         let sm = SceneModel::build(&spec).unwrap();
         let m = sm.model();
         let mass = m.body_mass()[body(m, "object")];
         assert!((mass - paper_kg).abs() < 1e-9, "{name:?}: {mass} kg");
-        let object = name.model().unwrap();
+        let object = ObjectConfig::named(name).model().unwrap();
         assert!((object.mass_kg - paper_kg).abs() < 1e-9, "{name:?}: the object model reads {} kg", object.mass_kg);
         // The grip geometry the scene places by matches the compiled scene, and the strip's whole helix
         // (width, plus its rise over the full length) lies on the grip capsule's straight part.

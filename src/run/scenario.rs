@@ -164,9 +164,10 @@ impl PickPlaceScenario {
     pub fn identity(&self, backend: &str) -> RunIdentity {
         RunIdentity {
             scenario: self.name.clone(),
-            object: self.object.name.to_string(),
-            // From the object's model file (NaN only if it does not load, when no run can start).
-            mass_kg: self.object.name.model().map_or(f64::NAN, |m| m.mass_kg),
+            object: self.object.label(),
+            // The override, else the object's model file (NaN only if it does not load, when no run
+            // can start).
+            mass_kg: self.object.mass_kg.unwrap_or_else(|| self.object.model().map_or(f64::NAN, |m| m.mass_kg)),
             feedback: self.feedback,
             gains: Gains { kp: self.controller.kp, ki: self.controller.ki, kd: self.controller.kd },
             setpoint_n: self.setpoint_n,

@@ -6,6 +6,7 @@
 //! failure is a [`ScenarioError`] that names the file, the dotted key and the reason.
 
 mod overrides;
+mod paths;
 mod validate;
 
 pub use overrides::{Override, apply_overrides};
@@ -73,7 +74,8 @@ pub fn from_str<T: DeserializeOwned + Validate>(
 }
 
 /// Deserialises and validates an already-parsed table (sweeps build these directly).
-pub fn from_table<T: DeserializeOwned + Validate>(table: toml::Table, file: &Path) -> Result<T, ScenarioError> {
+pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: &Path) -> Result<T, ScenarioError> {
+    paths::resolve_object(&mut table, file);
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
         let key = if path == "." { "(top level)".to_string() } else { path };

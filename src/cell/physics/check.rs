@@ -172,7 +172,7 @@ mod tests {
                 .unwrap();
         assert_eq!(s.physics.timestep_s, 0.002);
         assert_eq!(s.physics.cone, super::super::Cone::Pyramidal);
-        assert_eq!(s.object.name, super::super::ObjectName::Hammer);
+        assert_eq!(s.object.name.as_deref(), Some("hammer"));
         assert_eq!(s.finger, FingerConfig::default());
         let err = load("[finger]\nrelaxed_fraction = 1.5\n").unwrap_err().to_string();
         assert!(err.contains("finger.relaxed_fraction"), "{err}");

@@ -203,7 +203,7 @@ pub fn placement(spec: &SceneSpec, object: Option<&ObjectModel>) -> Placement {
 
 /// The full scene MJCF for `spec`, and where its parts start.
 pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
-    let object = spec.object.as_ref().map(|o| o.name.model()).transpose()?;
+    let object = spec.object.as_ref().map(|o| o.model()).transpose()?;
     let place = placement(spec, object.as_ref());
     let mut worldbody = String::new();
     let mut actuator = String::new();

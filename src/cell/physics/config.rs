@@ -3,6 +3,7 @@
 
 use crate::scenario::{Checker, Validate};
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// MuJoCo's integrator (`<option integrator>`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -471,35 +472,132 @@ impl ObjectName {
             ObjectName::Shampoo => include_str!("../../../models/objects/shampoo.xml"),
         }
     }
-
-    /// The object's model, read from its file (mass, grip radius, wrap height).
-    pub fn model(self) -> Result<super::object::ObjectModel, super::PhysicsError> {
-        super::object::ObjectModel::from_mjcf(&self.to_string(), self.mjcf())
-    }
 }
 
 /// `[object]`: which object, where it stands, and optional overrides.
+///
+/// The object is a model file (see [`super::object`] for the contract it keeps): `file`, a path
+/// relative to the scenario file, or `name`, a shipped object found at run time as
+/// `models/objects/<name>.xml` beside the scenarios' folder (the three paper objects are also built
+/// into the binary, so it runs on its own). One of the two is required.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields)]
 pub struct ObjectConfig {
-    /// The object (`crimper` | `hammer` | `shampoo`).
-    pub name: ObjectName,
+    /// A shipped object (`crimper` | `hammer` | `shampoo`, or any `models/objects/<name>.xml`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// An object model file (MJCF), relative to the scenario file; wins over `name`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
     /// Sliding friction of the object against the finger, replacing the model's value on the grip
     /// (`object_grip`, the only part the finger and palm touch; the base keeps its table friction).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
     /// Where the object's footprint centre stands on the table, world x and y \[m\]. `None`: right under
     /// the gripper's wrap in the start pose (the scene starts at the grasp).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position_m: Option<[f64; 2]>,
+    /// The object's mass \[kg\], replacing the model's; its inertia is scaled with it (same shape,
+    /// same mass distribution).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    /// Turn of the object about the vertical before the grasp \[deg\] (0: as in its file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yaw_deg: Option<f64>,
 }
 
 impl Default for ObjectConfig {
+    /// The crimper, as in its file.
     fn default() -> Self {
-        ObjectConfig { name: ObjectName::Crimper, friction: None, position_m: None }
+        ObjectConfig::named(ObjectName::Crimper)
+    }
+}
+
+impl ObjectConfig {
+    /// A shipped object, as in its file.
+    pub fn named(name: ObjectName) -> ObjectConfig {
+        ObjectConfig {
+            name: Some(name.to_string()),
+            file: None,
+            friction: None,
+            position_m: None,
+            mass_kg: None,
+            yaw_deg: None,
+        }
+    }
+
+    /// What names the object in summaries: `name`, else the file's stem.
+    pub fn label(&self) -> String {
+        match (&self.name, &self.file) {
+            (Some(n), _) => n.clone(),
+            (None, Some(f)) => f.file_stem().map_or_else(|| f.display().to_string(), |s| s.to_string_lossy().into()),
+            (None, None) => String::new(),
+        }
+    }
+
+    /// The object's model: `file` read now (edits take effect without a rebuild), else the shipped
+    /// object `name` built into the binary.
+    pub fn model(&self) -> Result<super::object::ObjectModel, super::PhysicsError> {
+        use super::object::ObjectModel;
+        match (&self.file, &self.name) {
+            (Some(file), _) => {
+                let source = file.display().to_string();
+                let text = std::fs::read_to_string(file).map_err(|e| super::PhysicsError::Object {
+                    file: source.clone(),
+                    what: format!("cannot read: {e}"),
+                })?;
+                ObjectModel::from_mjcf(&source, &text)
+            }
+            (None, Some(name)) => {
+                let shipped: ObjectName =
+                    name.parse().map_err(|what| super::PhysicsError::Object { file: name.clone(), what })?;
+                ObjectModel::from_mjcf(name, shipped.mjcf())
+            }
+            (None, None) => Err(super::PhysicsError::Object {
+                file: "(none)".into(),
+                what: "[object] needs `name` or `file`".into(),
+            }),
+        }
+    }
+}
+
+impl std::str::FromStr for ObjectName {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<ObjectName, String> {
+        match s {
+            "crimper" => Ok(ObjectName::Crimper),
+            "hammer" => Ok(ObjectName::Hammer),
+            "shampoo" => Ok(ObjectName::Shampoo),
+            other => Err(format!(
+                "no shipped object `{other}` (built in: crimper, hammer, shampoo); give `object.file`, or put \
+                 models/objects/{other}.xml beside the scenarios' folder"
+            )),
+        }
     }
 }
 
 impl Validate for ObjectConfig {
     fn validate(&self, at: &mut Checker) {
+        at.require("name", self.name.is_some() || self.file.is_some(), || {
+            "[object] needs `name` (a shipped object) or `file` (an object model, relative to the scenario)".into()
+        });
+        match (&self.file, &self.name) {
+            (Some(file), _) => at.require("file", file.is_file(), || format!("no such file: {}", file.display())),
+            (None, Some(name)) => {
+                if let Err(reason) = name.parse::<ObjectName>() {
+                    at.require("name", false, || reason);
+                }
+            }
+            (None, None) => {}
+        }
+        if let Some(m) = self.mass_kg {
+            // A few grams to what the arm's 5 kg payload and the finger's ~10 N grip could ever carry.
+            at.in_range("mass_kg", m, 0.001, 5.0);
+        }
+        if let Some(yaw) = self.yaw_deg {
+            at.in_range("yaw_deg", yaw, -360.0, 360.0);
+        }
         if let Some(mu) = self.friction {
             at.in_range("friction", mu, 0.0, 5.0);
         }

@@ -1,7 +1,7 @@
 //! The assembled scene as one self-contained MJCF that MuJoCo's own tools open
 //! (`python -m mujoco.viewer --mjcf scene.xml`): every template field filled, and what
 //! [`SceneModel::build`] applies to the compiled model written into the text instead (the object's
-//! start pose on the table, a grip-friction override, the kinematic arm's armature), plus a
+//! start pose and yaw on the table, grip-friction and mass overrides, the kinematic arm's armature), plus a
 //! keyframe `start` holding the start state (arm at its home angles, finger retracted, object
 //! standing where the run starts it).
 //!
@@ -9,7 +9,7 @@
 //! use in every value the edits touch, so a model file the edits do not recognise is an error, not
 //! a silently different scene.
 
-use super::scene::KINEMATIC_ARM_ARMATURE;
+use super::scene::{KINEMATIC_ARM_ARMATURE, yaw_quaternion};
 use super::template::{num, nums};
 use super::{ArmMode, PhysicsError, Scene, SceneModel};
 use mujoco_rs::prelude::MjModel;
@@ -24,6 +24,26 @@ pub fn standalone_xml(model: &Arc<SceneModel>) -> Result<String, PhysicsError> {
     let mut xml = model.xml().to_string();
     if let (Some(obj), Some(p)) = (&spec.object, model.placement().object) {
         xml = set_attribute(&xml, "<body name=\"object\"", "pos", &nums(&[p.x, p.y, p.z]))?;
+        if let Some(yaw) = obj.yaw_deg {
+            xml = set_attribute(&xml, "<body name=\"object\"", "quat", &nums(&yaw_quaternion(yaw)))?;
+        }
+        if obj.mass_kg.is_some() {
+            // The scaled mass and inertia as the body's explicit inertial (it wins over the geoms').
+            let m = model.model();
+            let body = m
+                .name_to_id(mujoco_rs::mujoco_c::_mjtObjBase::mjOBJ_BODY, "object")
+                .ok_or(PhysicsError::Missing { kind: "body", name: "object".into() })?;
+            let inertial = format!(
+                "<inertial pos=\"{}\" quat=\"{}\" mass=\"{}\" diaginertia=\"{}\"/>",
+                nums(&m.body_ipos()[body]),
+                nums(&m.body_iquat()[body]),
+                num(m.body_mass()[body]),
+                nums(&m.body_inertia()[body])
+            );
+            let at = xml.find("<body name=\"object\"").and_then(|s| xml[s..].find('>').map(|e| s + e + 1));
+            let at = at.ok_or_else(|| PhysicsError::Compile { message: "export: no body `object`".into() })?;
+            xml.insert_str(at, &format!("\n      {inertial}"));
+        }
         if let Some(mu) = obj.friction {
             let grip =
                 ids_grip(model.model()).ok_or(PhysicsError::Missing { kind: "geom", name: "object_grip".into() })?;
@@ -86,6 +106,9 @@ fn check_same(used: &MjModel, xml: &str) -> Result<(), PhysicsError> {
     }
     if exported.geom_friction() != used.geom_friction() {
         return Err(differs("geom friction"));
+    }
+    if exported.body_mass() != used.body_mass() || exported.body_inertia() != used.body_inertia() {
+        return Err(differs("body mass or inertia"));
     }
     if exported.dof_armature() != used.dof_armature() {
         return Err(differs("joint armature"));

@@ -10,6 +10,15 @@ use mujoco_rs::prelude::{MjData, MjModel};
 use nalgebra::{Isometry3, Vector3};
 use std::sync::Arc;
 
+/// The quaternion (w, x, y, z) of a turn by `yaw_deg` about the vertical.
+pub(crate) fn yaw_quaternion(yaw_deg: f64) -> [f64; 4] {
+    if yaw_deg == 0.0 {
+        return [1.0, 0.0, 0.0, 0.0];
+    }
+    let half = yaw_deg.to_radians() / 2.0;
+    [half.cos(), 0.0, 0.0, half.sin()]
+}
+
 /// A compiled scene model and the element ids the readout needs. Build it once and share it (it is
 /// `Send + Sync`) between many [`Scene`]s, for example across threads.
 #[derive(Debug)]
@@ -81,7 +90,19 @@ impl SceneModel {
                 model.geom_friction_mut()[g][0] = mu;
             }
             if let (Some(adr), Some(p)) = (ids.object_qpos, placement.object) {
-                model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, 1.0, 0.0, 0.0, 0.0]);
+                let [w, x, y, z] = yaw_quaternion(obj.yaw_deg.unwrap_or(0.0));
+                model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, w, x, y, z]);
+            }
+            if let (Some(mass), Some(body)) = (obj.mass_kg, ids.object_body) {
+                // Same shape and mass distribution: the inertia scales with the mass.
+                let scale = mass / model.body_mass()[body];
+                model.body_mass_mut()[body] = mass;
+                for v in model.body_inertia_mut()[body].iter_mut() {
+                    *v *= scale;
+                }
+                // The constants MuJoCo derives from masses (subtree masses, the inverse weights its
+                // contact softness is scaled by) follow the new mass, as the compiler would set them.
+                MjData::new(&mut model).set_const();
             }
         }
         if spec.physics.arm_mode == ArmMode::Kinematic {

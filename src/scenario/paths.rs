@@ -1,0 +1,74 @@
+//! Paths a scenario names are relative to the scenario file, so a scenario and the files beside
+//! it move together. Resolved on the parsed table, before deserialising, so every reader of
+//! scenarios (runs, sweeps, studies, `serve`) sees the same absolute paths, and the effective
+//! scenario a run records points at the files it used.
+
+use std::path::Path;
+
+/// Resolves `[object]`'s paths against `scenario` (the file the table came from):
+/// - `object.file`, when relative, is taken from the scenario's folder;
+/// - `object.name` without a `file` is looked up as `models/objects/<name>.xml` beside the
+///   scenario's folder (the repository's layout: `scenarios/` next to `models/`), then in the
+///   scenario's own folder's `models/`; found, it becomes `object.file`, so the model is read at run
+///   time and edits take effect without a rebuild. Not found, the name stays a built-in object
+///   (or an error naming it, from validation).
+pub fn resolve_object(table: &mut toml::Table, scenario: &Path) {
+    let Some(toml::Value::Table(object)) = table.get_mut("object") else { return };
+    let dir = scenario.parent().unwrap_or(Path::new(""));
+    if let Some(toml::Value::String(file)) = object.get("file") {
+        let path = Path::new(file);
+        if path.is_relative() {
+            let joined = dir.join(path);
+            object.insert("file".into(), toml::Value::String(joined.display().to_string()));
+        }
+        return;
+    }
+    let Some(toml::Value::String(name)) = object.get("name") else { return };
+    // A name with a path separator or a dot is no shipped object's: never look outside models/.
+    if name.is_empty() || name.contains(['/', '\\', '.']) {
+        return;
+    }
+    let candidates = [dir.join("../models/objects"), dir.join("models/objects")];
+    if let Some(found) = candidates.iter().map(|d| d.join(format!("{name}.xml"))).find(|p| p.is_file()) {
+        let found = std::fs::canonicalize(&found).unwrap_or(found);
+        object.insert("file".into(), toml::Value::String(found.display().to_string()));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> toml::Table {
+        text.parse().unwrap()
+    }
+
+    #[test]
+    fn a_relative_file_is_taken_from_the_scenario_folder() {
+        let mut t = table("[object]\nfile = \"objects/mug.xml\"\n");
+        resolve_object(&mut t, Path::new("/lab/scenarios/mug.toml"));
+        assert_eq!(t["object"]["file"].as_str(), Some("/lab/scenarios/objects/mug.xml"));
+        let mut t = table("[object]\nfile = \"/abs/mug.xml\"\n");
+        resolve_object(&mut t, Path::new("/lab/scenarios/mug.toml"));
+        assert_eq!(t["object"]["file"].as_str(), Some("/abs/mug.xml"));
+    }
+
+    #[test]
+    fn a_name_finds_its_model_beside_the_scenarios_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("models/objects")).unwrap();
+        std::fs::create_dir_all(dir.path().join("scenarios")).unwrap();
+        std::fs::write(dir.path().join("models/objects/dowel.xml"), "<mujoco/>").unwrap();
+        let scenario = dir.path().join("scenarios/dowel.toml");
+        let mut t = table("[object]\nname = \"dowel\"\n");
+        resolve_object(&mut t, &scenario);
+        let file = t["object"]["file"].as_str().unwrap();
+        assert!(Path::new(file).is_file(), "{file}");
+        let mut t = table("[object]\nname = \"teapot\"\n");
+        resolve_object(&mut t, &scenario);
+        assert!(t["object"].get("file").is_none(), "no file for an object that is not there");
+        let mut t = table("[object]\nname = \"../scenarios/x\"\n");
+        resolve_object(&mut t, &scenario);
+        assert!(t["object"].get("file").is_none());
+    }
+}

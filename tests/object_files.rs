@@ -1,0 +1,123 @@
+//! Objects from files alone: a user's object model and scenario in a folder of their own, no Rust
+//! touched, run with and without feedback; shipped-style lookup by name beside the scenarios'
+//! folder; and broken object files refused before anything runs, naming the file and what is wrong.
+
+use std::path::Path;
+
+mod common;
+use common::cli::{stderr, tendril};
+
+/// A 250 g dowel on a round foot: the grip a 12.5 mm capsule of beech in a TPU wrap (μ 1.1).
+const DOWEL: &str = r#"<mujoco model="dowel">
+  <worldbody>
+    <body name="object" pos="0 0 0">
+      <freejoint name="object"/>
+      <site name="object_wrap" pos="0 0 0.1"/>
+      <geom name="object_base" type="cylinder" size="0.04 0.01" pos="0 0 0.01" mass="0.15"
+            contype="0" conaffinity="4" priority="1" friction="0.8 0.005 0.0001"/>
+      <geom name="object_grip" type="capsule" fromto="0 0 0.04 0 0 0.2" size="0.0125" mass="0.1"
+            contype="0" conaffinity="10" priority="1" friction="1.1 0.005 0.0001"/>
+    </body>
+  </worldbody>
+</mujoco>
+"#;
+
+const SCENARIO: &str = "name = \"dowel\"\nsetpoint_n = 0.8\n[object]\nfile = \"objects/dowel.xml\"\n\
+                        [physics]\nmax_penetration_m = 0.015\n";
+
+/// A lab folder: `scenario.toml` and `objects/dowel.xml` (with `object` replaced as given).
+fn lab(object: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("objects")).unwrap();
+    std::fs::write(dir.path().join("objects/dowel.xml"), object).unwrap();
+    std::fs::write(dir.path().join("scenario.toml"), SCENARIO).unwrap();
+    dir
+}
+
+fn run(scenario: &Path, out: &Path, extra: &[&str]) -> (std::process::Output, serde_json::Value) {
+    let mut args = vec!["run", scenario.to_str().unwrap(), "--out", out.to_str().unwrap()];
+    args.extend(extra);
+    let o = tendril(&args);
+    let summary = std::fs::read_to_string(out.join("summary.json"))
+        .map_or(serde_json::Value::Null, |t| serde_json::from_str(&t).unwrap());
+    (o, summary)
+}
+
+#[test]
+fn a_new_object_runs_from_files_alone() {
+    let dir = lab(DOWEL);
+    let scenario = dir.path().join("scenario.toml");
+    let (o, held) = run(&scenario, &dir.path().join("on"), &["--feedback", "on"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(held["outcome"], "held", "with feedback at 0.8 N the dowel is carried: {held}");
+    assert_eq!(held["object"], "dowel");
+    assert!((held["mass_kg"].as_f64().unwrap() - 0.25).abs() < 1e-9, "mass from the file: {held}");
+    // Near-zero grip friction never carries it, with feedback or without.
+    for fb in ["on", "off"] {
+        let (o, s) = run(
+            &scenario,
+            &dir.path().join(format!("slick-{fb}")),
+            &["--feedback", fb, "--set", "object.friction=0.02"],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert_eq!(s["outcome"], "dropped", "μ 0.02, feedback {fb}: {s}");
+    }
+    // The mass key: a ten times heavier dowel is not carried by the same grip.
+    let (_, heavy) = run(&scenario, &dir.path().join("heavy"), &["--set", "object.mass_kg=2.5"]);
+    assert_eq!(heavy["mass_kg"], 2.5);
+    assert_eq!(heavy["outcome"], "dropped", "{heavy}");
+}
+
+#[test]
+fn a_name_finds_models_objects_beside_the_scenarios_folder_and_edits_need_no_rebuild() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("models/objects")).unwrap();
+    std::fs::create_dir_all(dir.path().join("scenarios")).unwrap();
+    std::fs::write(dir.path().join("models/objects/dowel.xml"), DOWEL).unwrap();
+    let scenario = dir.path().join("scenarios/dowel.toml");
+    std::fs::write(&scenario, SCENARIO.replace("file = \"objects/dowel.xml\"", "name = \"dowel\"")).unwrap();
+    let (o, s) = run(&scenario, &dir.path().join("a"), &["--set", "task.grasp_s=3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!((s["mass_kg"].as_f64().unwrap() - 0.25).abs() < 1e-9);
+    // Edit the model file: the next run reads it.
+    std::fs::write(dir.path().join("models/objects/dowel.xml"), DOWEL.replace("mass=\"0.1\"", "mass=\"0.2\"")).unwrap();
+    let (_, s) = run(&scenario, &dir.path().join("b"), &["--set", "task.grasp_s=3"]);
+    assert!((s["mass_kg"].as_f64().unwrap() - 0.35).abs() < 1e-9, "{s}");
+}
+
+#[test]
+fn broken_object_files_are_refused_naming_the_file_and_what_is_wrong() {
+    let cases = [
+        (DOWEL.replace("name=\"object\"", "name=\"dowel\""), "body named `object`"),
+        (DOWEL.replace("<freejoint name=\"object\"/>", ""), "free joint"),
+        (DOWEL.replace("name=\"object_grip\"", "name=\"shaft\""), "object_grip"),
+        (DOWEL.replace("<site name=\"object_wrap\" pos=\"0 0 0.1\"/>", ""), "object_wrap"),
+        (DOWEL.replace("type=\"capsule\"", "type=\"mesh\" mesh=\"nope\""), "cannot compile"),
+    ];
+    for (text, what) in cases {
+        let dir = lab(&text);
+        let out = dir.path().join("out");
+        let (o, _) = run(&dir.path().join("scenario.toml"), &out, &[]);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{what}: accepted");
+        assert!(err.contains("dowel.xml") && err.contains(what), "{what}: {err}");
+        assert!(!out.join("trace.csv").exists(), "{what}: something ran");
+    }
+}
+
+#[test]
+fn a_missing_file_or_an_object_without_name_or_file_is_an_error_naming_the_key() {
+    let dir = lab(DOWEL);
+    let scenario = dir.path().join("scenario.toml");
+    for (set, key) in [("object.file=\"objects/none.xml\"", "object.file"), ("object.name=\"teapot\"", "object.name")] {
+        let text = SCENARIO.replace("file = \"objects/dowel.xml\"", &set.replace("object.", ""));
+        std::fs::write(&scenario, text).unwrap();
+        let (o, _) = run(&scenario, &dir.path().join("x"), &[]);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(key), "{key}: {}", stderr(&o));
+    }
+    std::fs::write(&scenario, SCENARIO.replace("file = \"objects/dowel.xml\"\n", "friction = 1.0\n")).unwrap();
+    let (o, _) = run(&scenario, &dir.path().join("y"), &[]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("object.name") && stderr(&o).contains("`file`"), "{}", stderr(&o));
+}
