@@ -76,6 +76,7 @@ pub fn from_str<T: DeserializeOwned + Validate>(
 /// Deserialises and validates an already-parsed table (sweeps build these directly).
 pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: &Path) -> Result<T, ScenarioError> {
     paths::resolve_object(&mut table, file);
+    paths::resolve_models(&mut table, file);
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
         let key = if path == "." { "(top level)".to_string() } else { path };

@@ -1,4 +1,4 @@
-//! Paths a scenario names are relative to the scenario file, so a scenario and the files beside
+//! Paths a scenario names (`object.file`, `physics.models_dir`) are relative to the scenario file, so a scenario and the files beside
 //! it move together. Resolved on the parsed table, before deserialising, so every reader of
 //! scenarios (runs, sweeps, studies, `serve`) sees the same absolute paths, and the effective
 //! scenario a run records points at the files it used.
@@ -70,5 +70,32 @@ mod tests {
         let mut t = table("[object]\nname = \"../scenarios/x\"\n");
         resolve_object(&mut t, &scenario);
         assert!(t["object"].get("file").is_none());
+    }
+}
+
+/// Resolves `physics.models_dir` against `scenario`: a relative folder is taken from the scenario's
+/// folder; none given, `models/` beside the scenario's folder is used when it holds finger.xml.
+/// Only scenarios of a scene (those with an `[object]` or `[physics]` table) get one; the bench
+/// scenarios have no scene.
+pub fn resolve_models(table: &mut toml::Table, scenario: &Path) {
+    if !(table.contains_key("object") || table.contains_key("physics")) {
+        return;
+    }
+    let dir = scenario.parent().unwrap_or(Path::new(""));
+    let physics = table.entry("physics").or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let Some(physics) = physics.as_table_mut() else { return };
+    match physics.get("models_dir") {
+        Some(toml::Value::String(given)) if Path::new(given).is_relative() => {
+            let joined = dir.join(given);
+            physics.insert("models_dir".into(), toml::Value::String(joined.display().to_string()));
+        }
+        Some(_) => {}
+        None => {
+            let beside = dir.join("../models");
+            if beside.join("finger.xml").is_file() {
+                let beside = std::fs::canonicalize(&beside).unwrap_or(beside);
+                physics.insert("models_dir".into(), toml::Value::String(beside.display().to_string()));
+            }
+        }
     }
 }

@@ -7,7 +7,8 @@
 //! force feedback, so the object slips out and a drop time exists to compare. Speed is simulated
 //! seconds per wall second, with runs one at a time so they do not share cores.
 
-use super::{StudyRun, cell, run_all, set, write_csv};
+use super::convergence::force_rmse;
+use super::{cell, run_all, set, write_csv};
 use crate::plot::speed_accuracy::{SpeedAccuracyRow, render};
 use std::path::{Path, PathBuf};
 
@@ -98,23 +99,6 @@ impl Point {
     }
 }
 
-/// RMS difference of two runs' true sensor force over the ticks both have in holding phases,
-/// up to the first drop of either: after it the force is a falling object striking the strip,
-/// chaotic in any simulation, and would swamp the comparison.
-fn trace_rmse(run: &StudyRun, reference: &StudyRun) -> Option<f64> {
-    let (a, b) = (run.report.as_ref()?, reference.report.as_ref()?);
-    let first_drop = [a.drop, b.drop].iter().flatten().map(|d| d.cell_time_s).fold(f64::INFINITY, f64::min);
-    let diffs: Vec<f64> = a
-        .rows
-        .iter()
-        .zip(&b.rows)
-        .filter(|(x, y)| x.phase.holding() && y.phase.holding() && x.time_s < first_drop)
-        .map(|(x, y)| (x.true_force_n - y.true_force_n).powi(2))
-        .filter(|d| d.is_finite())
-        .collect();
-    (!diffs.is_empty()).then(|| (diffs.iter().sum::<f64>() / diffs.len() as f64).sqrt())
-}
-
 /// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`.
 /// `defaults` names the project's default settings (timestep, integrator, cone, links) to
 /// highlight. Returns the files written.
@@ -153,7 +137,7 @@ pub fn run(scenario: &Path, grid: &Grid, defaults: (f64, &str, &str, u32), out: 
                 force_rmse_n: if i == 0 {
                     Some(0.0)
                 } else if ok {
-                    trace_rmse(r, reference)
+                    force_rmse(r, reference)
                 } else {
                     None
                 },

@@ -5,12 +5,29 @@ use super::object::ObjectModel;
 use super::template::{num, nums, render, section};
 use super::{PhysicsError, SceneSpec, ur5e};
 use nalgebra::{Isometry3, Point3, Vector3};
+use std::path::Path;
 
-const FINGER: &str = include_str!("../../../models/finger.xml");
-const SEGMENT: &str = include_str!("../../../models/finger_segment.xml");
-const PAD: &str = include_str!("../../../models/sensor_pad.xml");
-const UR5E: &str = include_str!("../../../models/ur5e.xml");
-const TABLE: &str = include_str!("../../../models/table.xml");
+/// The scene's parts as built into the binary: the fallback when no models folder is given.
+const BUILT_IN: [(&str, &str); 5] = [
+    ("finger.xml", include_str!("../../../models/finger.xml")),
+    ("finger_segment.xml", include_str!("../../../models/finger_segment.xml")),
+    ("sensor_pad.xml", include_str!("../../../models/sensor_pad.xml")),
+    ("ur5e.xml", include_str!("../../../models/ur5e.xml")),
+    ("table.xml", include_str!("../../../models/table.xml")),
+];
+
+/// The text of the part `name`: read from `dir` when given (so an edited `models/finger.xml` takes
+/// effect on the next run, no rebuild), else the built-in copy.
+fn part(dir: Option<&Path>, name: &str) -> Result<String, PhysicsError> {
+    match dir {
+        Some(dir) => {
+            let file = dir.join(name);
+            std::fs::read_to_string(&file)
+                .map_err(|e| PhysicsError::Part { file: file.display().to_string(), cause: e.to_string() })
+        }
+        None => Ok(BUILT_IN.iter().find(|(n, _)| *n == name).map(|(_, text)| text.to_string()).unwrap_or_default()),
+    }
+}
 
 /// Height of the pad's bump tip above the casing's base \[m\]: 4 mm casing + 1.5 mm bump (sensor_pad.xml).
 pub const PAD_HEIGHT_M: f64 = 0.0055;
@@ -84,7 +101,9 @@ pub fn header(p: &PhysicsConfig) -> String {
 
 /// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
 /// document whose hand body goes into the arm's flange.
-pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
+pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, PhysicsError> {
+    let (finger_text, segment_text, pad_text) =
+        (part(models, "finger.xml")?, part(models, "finger_segment.xml")?, part(models, "sensor_pad.xml")?);
     let n = f.segments as usize;
     let l = f.segment_length_m();
     let r = f.thickness_m / 2.0;
@@ -101,7 +120,7 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
     // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
     let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
     let pad = render(
-        body_of(PAD),
+        body_of(&pad_text),
         &[
             ("x", num(pad_x)),
             ("r", num(r)),
@@ -110,7 +129,7 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
             ("site_y", num(r + 0.005 + sink)),
         ],
     )?;
-    let segment_body = body_of(SEGMENT);
+    let segment_body = body_of(&segment_text);
     let rigid_body = without_joint(segment_body);
     let mut chain = String::new();
     for i in (0..n).rev() {
@@ -144,7 +163,7 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
     // The dashpot's node needs some inertia; 1e-3 kg keeps its own time constant (m / c) far below tau.
     let creep_damping = f.relaxation_time_s * k_maxwell.max(1e-9);
     render(
-        body_of(FINGER),
+        body_of(&finger_text),
         &[
             ("exit_z", num(f.exit_z_m)),
             ("length", num(f.length_m)),
@@ -203,6 +222,7 @@ pub fn placement(spec: &SceneSpec, object: Option<&ObjectModel>) -> Placement {
 
 /// The full scene MJCF for `spec`, and where its parts start.
 pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
+    let models = spec.physics.models_dir.as_deref();
     let object = spec.object.as_ref().map(|o| o.model()).transpose()?;
     let place = placement(spec, object.as_ref());
     let mut worldbody = String::new();
@@ -211,14 +231,14 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     let mut sensor = String::new();
 
     if spec.object.is_some() {
-        let table = TABLE.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
+        let table = part(models, "table.xml")?.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
         worldbody.push_str(section(&table, "worldbody"));
         worldbody.push_str(section(object.as_ref().map_or("", |o| o.mjcf.as_str()), "worldbody"));
     }
     // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
     // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
-    let finger_doc = finger(&spec.finger)?;
-    let arm = render(UR5E, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
+    let finger_doc = finger(&spec.finger, models)?;
+    let arm = render(&part(models, "ur5e.xml")?, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
     worldbody.push_str(section(&arm, "worldbody"));
     if spec.physics.arm_mode == ArmMode::Dynamic {
         actuator.push_str(section(&arm, "actuator"));

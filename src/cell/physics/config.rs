@@ -168,6 +168,12 @@ pub enum ArmMode {
 pub struct PhysicsConfig {
     /// The engine (`mujoco` | `rapier`); `--backend` on the command line sets it too.
     pub backend: Backend,
+    /// The folder the scene's parts (finger.xml, finger_segment.xml, sensor_pad.xml, ur5e.xml,
+    /// table.xml) are read from at run time, relative to the scenario file. Not given: `models/`
+    /// beside the scenario's folder if it holds finger.xml (the repository's layout), else the
+    /// copies built into the binary.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub models_dir: Option<PathBuf>,
     /// Simulation step \[s\]. 5 ms: the largest step at which the contact time constant (10 ms) is still
     /// two steps (MuJoCo's minimum) and the pinch bound holds to 0.02 %; 2 ms runs ~2.5x slower.
     pub timestep_s: f64,
@@ -237,6 +243,7 @@ impl Default for PhysicsConfig {
             max_penetration_m: 0.005,
             max_kinetic_energy_j: 200.0,
             rapier: RapierConfig::default(),
+            models_dir: None,
         }
     }
 }

@@ -148,6 +148,14 @@ pub enum PhysicsError {
         /// The value given.
         value: f64,
     },
+    /// A part of the scene (models/finger.xml, ...) could not be read from the models folder.
+    #[error("{file}: cannot read this part of the scene: {cause}")]
+    Part {
+        /// The part's file.
+        file: String,
+        /// Why.
+        cause: String,
+    },
     /// An object's model file breaks the object contract (see [`object`]).
     #[error("object model {file}: {what}")]
     Object {
