@@ -64,9 +64,27 @@ pub fn run_on_cell(
     let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
     let summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
     if let Some(dir) = out {
+        // Both files are attempted, and every failure is reported: a trace that could not be
+        // written is an error even when summary.json could be.
+        let mut failures = Vec::new();
+        if let Some(e) = trace.as_ref().and_then(TraceWriter::error) {
+            failures.push(format!("{}: cannot write: {e}", dir.join("trace.csv").display()));
+        }
         let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
-            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+        if let Err(e) = write_synced(&path, (serde_json::to_string_pretty(&summary)? + "\n").as_bytes()) {
+            failures.push(format!("{}: cannot write: {e}", path.display()));
+        }
+        if !failures.is_empty() {
+            anyhow::bail!("{}", failures.join("; "));
+        }
     }
     Ok((summary, report))
+}
+
+/// Writes `bytes` to `path` and syncs them, so a reported success is on disk.
+fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut f = std::fs::File::create(path)?;
+    f.write_all(bytes)?;
+    f.sync_data()
 }

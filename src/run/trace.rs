@@ -44,9 +44,13 @@ pub struct TraceRow {
 const HEADER: &str = "time_s,phase,true_force_n,fbg1_nm,fbg2_nm,force_n,force_uncompensated_n,over_range,setpoint_n,\
 controller_on,controller_output_deg_s,growth_motor_rad,twine_motor_rad,object_height_m,slip_speed_m_s,grip_force_n";
 
-/// Streams rows to a CSV file; rows already written survive a failed run.
+/// Streams rows to a CSV file; rows already written survive a failed run. Each row is formatted
+/// whole before it reaches the buffer, so the file only ever ends between rows unless a write
+/// fails; the first write error is kept ([`TraceWriter::error`]) so it can be reported even when
+/// the run goes on to fail for it.
 pub struct TraceWriter {
     out: std::io::BufWriter<std::fs::File>,
+    error: Option<String>,
 }
 
 impl TraceWriter {
@@ -54,14 +58,13 @@ impl TraceWriter {
     pub fn create(path: &Path) -> std::io::Result<TraceWriter> {
         let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
         writeln!(out, "{HEADER}")?;
-        Ok(TraceWriter { out })
+        Ok(TraceWriter { out, error: None })
     }
 
     /// Appends one row.
     pub fn write(&mut self, r: &TraceRow) -> std::io::Result<()> {
-        writeln!(
-            self.out,
-            "{:.4},{},{:.5},{:.4},{:.4},{:.5},{:.5},{},{:.3},{},{:.3},{:.5},{:.5},{:.5},{:.5},{:.4}",
+        let line = format!(
+            "{:.4},{},{:.5},{:.4},{:.4},{:.5},{:.5},{},{:.3},{},{:.3},{:.5},{:.5},{:.5},{:.5},{:.4}\n",
             r.time_s,
             r.phase.name(),
             r.true_force_n,
@@ -78,11 +81,28 @@ impl TraceWriter {
             r.object_height_m,
             r.slip_speed_m_s,
             r.grip_force_n,
-        )
+        );
+        let written = self.out.write_all(line.as_bytes());
+        self.keep(written)
     }
 
     /// Flushes everything written so far to disk.
     pub fn flush(&mut self) -> std::io::Result<()> {
-        self.out.flush()
+        let flushed = self.out.flush().and_then(|()| self.out.get_ref().sync_data());
+        self.keep(flushed)
+    }
+
+    /// The first write error, if any.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    fn keep(&mut self, result: std::io::Result<()>) -> std::io::Result<()> {
+        if let Err(e) = &result
+            && self.error.is_none()
+        {
+            self.error = Some(e.to_string());
+        }
+        result
     }
 }
