@@ -58,6 +58,8 @@ enum Command {
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
 pub fn main() -> ExitCode {
+    // SAFETY: first thing, before any thread exists that could use MuJoCo.
+    unsafe { crate::mujoco_log::install() };
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Reproduce(a) => reproduce::run(a),

@@ -40,6 +40,8 @@ pub fn run_on_twin(
     out: Option<&Path>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     let started = std::time::Instant::now();
+    // Warnings left on this thread by an earlier run are not this run's.
+    let _ = crate::mujoco_log::take_warnings();
     let mut cell = SimCell::for_scenario(scenario, models.get(&scenario.scene_spec())?);
     run_on_cell(&mut cell, scenario, out, started)
 }
@@ -62,7 +64,9 @@ pub fn run_on_cell(
         None => None,
     };
     let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
-    let summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
+    let mut summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
+    // The run's own thread stepped its physics (and compiled its model, if not cached).
+    summary.warnings = crate::mujoco_log::take_warnings();
     if let Some(dir) = out {
         // Both files are attempted, and every failure is reported: a trace that could not be
         // written is an error even when summary.json could be.

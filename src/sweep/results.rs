@@ -18,6 +18,15 @@ pub fn flatten_summary(summary: &RunSummary) -> Vec<(String, String)> {
             }
             serde_json::Value::Null => out.push((prefix.to_string(), String::new())),
             serde_json::Value::String(s) => out.push((prefix.to_string(), s.clone())),
+            // A list of messages (the MuJoCo warnings) is one cell.
+            serde_json::Value::Array(items) => out.push((
+                prefix.to_string(),
+                items
+                    .iter()
+                    .map(|v| v.as_str().map_or_else(|| v.to_string(), str::to_string))
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            )),
             other => out.push((prefix.to_string(), other.to_string())),
         }
     }
