@@ -22,7 +22,7 @@ pub enum FitError {
         /// Which input: `x`, `y` or `design`.
         what: &'static str,
     },
-    /// The SVD did not converge within [`MAX_SVD_ITERATIONS`].
+    /// The SVD did not converge within `MAX_SVD_ITERATIONS` (10 000) iterations.
     #[error("the least-squares solution did not converge within {MAX_SVD_ITERATIONS} iterations")]
     NoConvergence,
 }

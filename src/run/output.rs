@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-/// Longest folder name derived from a scenario name [bytes]: well under the 255 bytes most file
+/// Longest folder name derived from a scenario name \[bytes\]: well under the 255 bytes most file
 /// systems allow for one path component.
 pub const MAX_COMPONENT_LEN: usize = 100;
 
