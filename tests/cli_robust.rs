@@ -152,6 +152,7 @@ fn unbounded_arguments_are_refused_at_once() {
     for args in [
         vec!["sweep", "scenarios/sweep-gains.toml", "--threads", "100000"],
         vec!["sweep", "scenarios/sweep-gains.toml", "--threads", "0"],
+        vec!["chart", "gain-map", "--threads", "100000"],
         vec!["serve", "scenarios/crimper.toml", "--seconds", "nan"],
         vec!["serve", "scenarios/crimper.toml", "--seconds", "-1"],
         vec!["latency", "--rate-hz", "0.001", "--seconds", "1"],

@@ -22,8 +22,9 @@ pub struct ChartArgs {
     /// A small grid, for a quick look.
     #[arg(long)]
     quick: bool,
-    /// Worker threads for the studies that do not time runs (stability, gain-map).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads for the studies that do not time runs (stability, gain-map); 0: all cores,
+    /// at most 1024.
+    #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
 }
 

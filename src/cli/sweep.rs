@@ -38,6 +38,11 @@ fn threads(s: &str) -> Result<usize, String> {
     }
 }
 
+/// `--threads N` with 0 (all cores) or 1 <= N <= [`MAX_THREADS`], for `chart`.
+pub(super) fn threads_or_all(s: &str) -> Result<usize, String> {
+    if s.trim() == "0" { Ok(0) } else { threads(s) }
+}
+
 /// Arguments of `tendril merge`.
 #[derive(Debug, clap::Args)]
 pub struct MergeArgs {

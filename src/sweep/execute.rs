@@ -60,14 +60,21 @@ pub fn results_path(out_dir: &Path, shard: Option<Shard>) -> PathBuf {
 /// sweep file, at `grid."key"` or `list[i].key`, with the run and scenario it was found in.
 pub fn check_runs(sweep: &Sweep) -> Result<(), crate::scenario::ScenarioError> {
     use crate::scenario::ScenarioError;
-    // Each scenario file is read once; the runs only differ in their overrides.
-    let mut texts: std::collections::HashMap<&Path, String> = Default::default();
+    // Each scenario file is read and parsed once; the runs only differ in their overrides.
+    let mut tables: std::collections::HashMap<&Path, toml::Table> = Default::default();
     for run in &sweep.runs {
-        if !texts.contains_key(run.scenario.as_path()) {
-            texts.insert(&run.scenario, crate::scenario::read_text(&run.scenario)?);
+        if !tables.contains_key(run.scenario.as_path()) {
+            let text = crate::scenario::read_text(&run.scenario)?;
+            let table = text.parse().map_err(|e: toml::de::Error| ScenarioError::Syntax {
+                file: run.scenario.clone(),
+                message: e.to_string(),
+            })?;
+            tables.insert(&run.scenario, table);
         }
-        let text = &texts[run.scenario.as_path()];
-        match crate::scenario::from_str::<PickPlaceScenario>(text, &run.scenario, &run.overrides) {
+        let mut table = tables[run.scenario.as_path()].clone();
+        let loaded = crate::scenario::apply_overrides(&mut table, &run.overrides)
+            .and_then(|()| crate::scenario::from_table::<PickPlaceScenario>(table, &run.scenario));
+        match loaded {
             Ok(_) => {}
             Err(ScenarioError::Invalid { key, reason, .. }) if run.overrides.iter().any(|o| o.key == key) => {
                 let place = match run.list_index.filter(|_| list_sets(sweep, run, &key)) {

@@ -94,7 +94,12 @@ pub fn identity_cells(sweep: &Sweep, id: &str, run: &SweepRun) -> Vec<String> {
     for key in &sweep.keys {
         r.push(run.overrides.iter().find(|o| &o.key == key).map(|o| value_text(&o.value)).unwrap_or_default());
     }
-    r
+    r.into_iter().map(one_line).collect()
+}
+
+/// A cell on one line: line breaks become spaces (see [`row`]).
+fn one_line(cell: String) -> String {
+    if cell.contains(['\n', '\r']) { cell.replace(['\n', '\r'], " ") } else { cell }
 }
 
 /// One results row for `run` of the sweep whose [`sweep_id`] is `id`. Line breaks inside cells
@@ -103,7 +108,7 @@ pub fn identity_cells(sweep: &Sweep, id: &str, run: &SweepRun) -> Vec<String> {
 pub fn row(sweep: &Sweep, id: &str, run: &SweepRun, summary: &RunSummary) -> Vec<String> {
     let mut r = identity_cells(sweep, id, run);
     r.extend(flatten_summary(summary).into_iter().map(|(_, v)| v));
-    r.into_iter().map(|c| c.replace(['\n', '\r'], " ")).collect()
+    r.into_iter().map(one_line).collect()
 }
 
 /// Merges shard files into `out`: one header, rows sorted by run id, duplicates dropped.
