@@ -110,9 +110,11 @@ fn emit(text: &str) {
     }
 }
 
-/// Writes `text` to `path`, naming the file in the error.
+/// Writes `text` to `path` atomically (a failure keeps the previous file), naming the file in the
+/// error.
 fn write_file(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
-    std::fs::write(path, text).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+    crate::run::output::write_atomically(path, text.as_bytes())
+        .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
 }
 
 /// Longest duration a `--seconds` argument accepts \[s\]: a week, longer than any session on the

@@ -75,20 +75,13 @@ pub fn run_on_cell(
             failures.push(format!("{}: cannot write: {e}", dir.join("trace.csv").display()));
         }
         let path = dir.join("summary.json");
-        if let Err(e) = write_synced(&path, (serde_json::to_string_pretty(&summary)? + "\n").as_bytes()) {
-            failures.push(format!("{}: cannot write: {e}", path.display()));
+        let json = serde_json::to_string_pretty(&summary)? + "\n";
+        if let Err((file, e)) = super::output::write_atomically(&path, json.as_bytes()) {
+            failures.push(format!("{}: cannot write: {e}", file.display()));
         }
         if !failures.is_empty() {
             anyhow::bail!("{}", failures.join("; "));
         }
     }
     Ok((summary, report))
-}
-
-/// Writes `bytes` to `path` and syncs them, so a reported success is on disk.
-fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let mut f = std::fs::File::create(path)?;
-    f.write_all(bytes)?;
-    f.sync_data()
 }

@@ -198,22 +198,9 @@ pub fn read_regular(path: &Path) -> Result<Vec<u8>, ResultsError> {
     std::fs::read(path).map_err(|source| ResultsError::io(path, source))
 }
 
-/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it over `path`: `path`
-/// is either the old file or the whole new one, never half of it.
+/// Writes `bytes` over `path` atomically ([`crate::run::output::write_atomically`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ResultsError> {
-    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
-    name.push(".tmp");
-    let tmp = path.with_file_name(name);
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()
-    };
-    if let Err(source) = write() {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(ResultsError::io(&tmp, source));
-    }
-    std::fs::rename(&tmp, path).map_err(|source| ResultsError::io(path, source))
+    crate::run::output::write_atomically(path, bytes).map_err(|(file, source)| ResultsError::Io { file, source })
 }
 
 /// What opening a results file found.
