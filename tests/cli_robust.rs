@@ -186,3 +186,31 @@ fn a_scenario_name_cannot_write_outside_out() {
     assert!(!dir.path().join("escaped_by_name").exists());
     assert!(!Path::new("/tmp/absolute_by_name/summary.json").exists());
 }
+
+#[test]
+fn serve_stops_cleanly_on_sigterm() {
+    // Four free consecutive ports: bound and released by the OS's choice of the first.
+    let base = (0..50)
+        .find_map(|_| {
+            let l = std::net::TcpListener::bind("127.0.0.1:0").ok()?;
+            let p = l.local_addr().ok()?.port();
+            drop(l);
+            (p < 65000 && (1..4).all(|i| std::net::TcpListener::bind(("127.0.0.1", p + i)).is_ok())).then_some(p)
+        })
+        .expect("free ports");
+    let out = signal_after(
+        tendril_command().args([
+            "serve",
+            "scenarios/short-lift.toml",
+            "--seconds",
+            "60",
+            "--port-base",
+            &base.to_string(),
+        ]),
+        libc::SIGTERM,
+        Duration::from_millis(2000),
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("twin ran"), "the status is reported");
+    assert!(stderr(&out).contains("SIGTERM: stopping cleanly"), "{}", stderr(&out));
+}

@@ -97,7 +97,13 @@ pub enum CsvError {
 impl BenchRecord {
     /// Reads a bench CSV (see the module docs for the columns).
     pub fn read_csv(file: &Path) -> Result<BenchRecord, CsvError> {
-        let text = std::fs::read_to_string(file).map_err(|source| CsvError::Io { file: file.into(), source })?;
+        let bytes = std::fs::read(file).map_err(|source| CsvError::Io { file: file.into(), source })?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+            let column = valid.len() - valid.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1) + 1;
+            CsvError::Row { file: file.into(), line, reason: format!("column {column}: not UTF-8 text") }
+        })?;
         BenchRecord::parse_csv(&text, file)
     }
 
@@ -257,5 +263,12 @@ mod tests {
         let err = parse("0,0,1540,1e9,\n").unwrap_err().to_string();
         assert!(err.contains("fbg2_nm"), "{err}");
         assert!(parse("0,,1540,1550,\n0.1,,1540,1550,\n").is_ok());
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("b.csv");
+        let mut bytes = format!("{CSV_HEADER}\n0,0,15").into_bytes();
+        bytes.extend_from_slice(b"\xff40,1550,\n");
+        std::fs::write(&f, bytes).unwrap();
+        let err = BenchRecord::read_csv(&f).unwrap_err().to_string();
+        assert!(err.contains("b.csv: line 2") && err.contains("column 7: not UTF-8"), "{err}");
     }
 }
