@@ -66,6 +66,6 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         run_on_twin(&scenario, &Default::default(), Some(&dir))?
     };
     emit(&render_text(&summary));
-    emit(&format!("wrote {0}/trace.csv and {0}/summary.json\n", dir.display()));
+    emit(&format!("wrote {0}/trace.csv, {0}/summary.json and {0}/scenario.toml\n", dir.display()));
     Ok(super::exit_for_runs(summary.outcome == "error"))
 }

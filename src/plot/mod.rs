@@ -1,9 +1,10 @@
 //! Charts (PNG and SVG) from files on disk: a run's trace, a sweep's heatmaps, the
-//! speed-against-accuracy scatter, the stability dot matrix and the gain maps.
+//! speed-against-accuracy scatter, the convergence panels, the stability dot matrix and the gain maps.
 //!
 //! Every chart is drawn once per backend by a [`Chart`] so the PNG and the SVG agree. Text uses
 //! DejaVu Sans embedded in the binary, so PNGs render on a machine without system fonts.
 
+pub mod convergence;
 pub mod gain_map;
 pub mod grid;
 pub mod input;
@@ -47,7 +48,7 @@ pub enum PlotError {
         message: String,
     },
     /// The path holds none of the files `tendril plot` knows.
-    #[error("{0}: no trace.csv, results.csv, speed_accuracy.csv, stability.csv or gain_map.csv here")]
+    #[error("{0}: no trace.csv, results.csv, speed_accuracy.csv, convergence.csv, stability.csv or gain_map.csv here")]
     NothingToPlot(String),
     /// Drawing failed (plotters backend error).
     #[error("{file}: drawing failed: {message}")]
@@ -131,6 +132,9 @@ pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotEr
     }
     if wanted("stability.csv") {
         written.extend(stability::render(&stability::read(&dir.join("stability.csv"))?, &out_dir)?);
+    }
+    if wanted("convergence.csv") {
+        written.extend(convergence::render(&convergence::read(&dir.join("convergence.csv"))?, &out_dir)?);
     }
     if wanted("gain_map.csv") {
         written.extend(gain_map::render(&gain_map::read(&dir.join("gain_map.csv"))?, &out_dir)?);

@@ -68,20 +68,43 @@ pub fn run_on_cell(
     // The run's own thread stepped its physics (and compiled its model, if not cached).
     summary.warnings = crate::mujoco_log::take_warnings();
     if let Some(dir) = out {
-        // Both files are attempted, and every failure is reported: a trace that could not be
+        // Every file is attempted, and every failure is reported: a trace that could not be
         // written is an error even when summary.json could be.
         let mut failures = Vec::new();
         if let Some(e) = trace.as_ref().and_then(TraceWriter::error) {
             failures.push(format!("{}: cannot write: {e}", dir.join("trace.csv").display()));
         }
-        let path = dir.join("summary.json");
-        let json = serde_json::to_string_pretty(&summary)? + "\n";
-        if let Err((file, e)) = super::output::write_atomically(&path, json.as_bytes()) {
-            failures.push(format!("{}: cannot write: {e}", file.display()));
+        if let Err(e) = write_summary(dir, &summary, scenario) {
+            failures.push(format!("{e:#}"));
         }
         if !failures.is_empty() {
             anyhow::bail!("{}", failures.join("; "));
         }
     }
     Ok((summary, report))
+}
+
+/// Writes `summary.json` with the effective scenario under `"effective_scenario"` (every key after the
+/// defaults, the file and the `--set` overrides: what tools read to know the timestep, links,
+/// gains... a run used), and that scenario again as `scenario.toml`, which `tendril run` takes
+/// as it is to repeat the run from its own directory.
+pub fn write_summary(dir: &Path, summary: &RunSummary, scenario: &PickPlaceScenario) -> anyhow::Result<()> {
+    let mut record = serde_json::to_value(summary)?;
+    if let serde_json::Value::Object(fields) = &mut record {
+        fields.insert("effective_scenario".into(), serde_json::to_value(scenario)?);
+    }
+    // Atomically: a failed write (a full disk) keeps the previous file whole.
+    let write = |path: &Path, text: &str| {
+        super::output::write_atomically(path, text.as_bytes())
+            .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
+    };
+    write(&dir.join("summary.json"), &(serde_json::to_string_pretty(&record)? + "\n"))?;
+    let path = dir.join("scenario.toml");
+    let text = toml::to_string(scenario).map_err(|e| anyhow::anyhow!("{}: cannot encode: {e}", path.display()))?;
+    write(
+        &path,
+        &format!(
+            "# The effective scenario of this run (defaults, file and --set applied): `tendril run` repeats it.\n{text}"
+        ),
+    )
 }

@@ -20,17 +20,21 @@ use crate::control::pid::PidConfig;
 use crate::control::slip::SlipConfig;
 use crate::control::task::TaskConfig;
 use crate::scenario::{Checker, Validate};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// A pick-and-place scenario (`scenarios/crimper.toml`, ...).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PickPlaceScenario {
     /// Scenario name, echoed in summaries.
     pub name: String,
     /// Seed of every random process (sensor noise) [-]; the same seed gives the same trace. Any
     /// `u64` (above `i64::MAX` as a decimal string, see [`crate::scenario::seed`]).
-    #[serde(default = "default_seed", deserialize_with = "crate::scenario::seed::deserialize")]
+    #[serde(
+        default = "default_seed",
+        deserialize_with = "crate::scenario::seed::deserialize",
+        serialize_with = "crate::scenario::seed::serialize"
+    )]
     pub seed: u64,
     /// Contact-force setpoint \[N\] (paper Sec. V-B: crimper 0.6, hammer 1.6, shampoo 0.8).
     pub setpoint_n: f64,

@@ -20,6 +20,15 @@ pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
     }
 }
 
+/// Serialises a seed as [`deserialize`] reads it: an integer up to `i64::MAX` (TOML's largest),
+/// a decimal string above, so `scenario.toml` round-trips every seed.
+pub fn serialize<S: serde::Serializer>(seed: &u64, s: S) -> Result<S::Ok, S::Error> {
+    match i64::try_from(*seed) {
+        Ok(i) => s.serialize_i64(i),
+        Err(_) => s.serialize_str(&seed.to_string()),
+    }
+}
+
 /// The TOML value for `seed`: an integer where TOML can hold it, else its decimal string.
 pub fn to_toml(seed: u64) -> toml::Value {
     i64::try_from(seed).map_or_else(|_| toml::Value::String(seed.to_string()), toml::Value::Integer)
@@ -27,9 +36,9 @@ pub fn to_toml(seed: u64) -> toml::Value {
 
 #[cfg(test)]
 mod tests {
-    #[derive(serde::Deserialize)]
+    #[derive(serde::Deserialize, serde::Serialize)]
     struct S {
-        #[serde(deserialize_with = "super::deserialize")]
+        #[serde(deserialize_with = "super::deserialize", serialize_with = "super::serialize")]
         seed: u64,
     }
 
@@ -42,5 +51,9 @@ mod tests {
         assert!(toml::from_str::<S>("seed = -1").is_err());
         assert!(toml::from_str::<S>("seed = \"x\"").is_err());
         assert_eq!(super::to_toml(u64::MAX), toml::Value::String(u64::MAX.to_string()));
+        for seed in [0, 7, i64::MAX as u64, i64::MAX as u64 + 1, u64::MAX] {
+            let back: S = toml::from_str(&toml::to_string(&S { seed }).unwrap()).unwrap();
+            assert_eq!(back.seed, seed);
+        }
     }
 }

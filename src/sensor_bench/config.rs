@@ -11,7 +11,10 @@ use serde::{Deserialize, Serialize};
 pub struct BenchScenario {
     /// Seed of every random draw (interrogator and load-cell noise) [-]; any `u64` (above
     /// `i64::MAX` as a decimal string, see [`crate::scenario::seed`]).
-    #[serde(deserialize_with = "crate::scenario::seed::deserialize")]
+    #[serde(
+        deserialize_with = "crate::scenario::seed::deserialize",
+        serialize_with = "crate::scenario::seed::serialize"
+    )]
     pub seed: u64,
     /// The sensor (defaults: the paper's).
     #[serde(default)]

@@ -3,10 +3,12 @@
 //! Each study loads one scenario with overrides per run, runs it on the twin, writes a CSV and
 //! draws its chart with [`crate::plot`].
 //!
+//! - [`convergence`]: each Section V case under timestep and finger-link refinement.
 //! - [`speed_accuracy`]: timestep × integrator × cone × finger links against a fine reference.
 //! - [`stability`]: the largest stable timestep per integrator, and what fails past it.
 //! - [`gain_map`]: where in (Kp, Ki) the loop oscillates or loses the object, per object.
 
+pub mod convergence;
 pub mod gain_map;
 pub mod speed_accuracy;
 pub mod stability;

@@ -20,6 +20,25 @@ pub const GROW_CLEARANCE_M: f64 = 0.001;
 /// load off the pad by ~10 %).
 pub const PALM_GAP_M: f64 = 0.0002;
 
+/// Half the sensor pad's casing length along the strip \[m\] (12 mm casing, paper Sec. II).
+pub const PAD_HALF_LENGTH_M: f64 = 0.006;
+
+/// The segment template without its `<joint .../>` element: a segment welded to its parent.
+fn without_joint(segment: &str) -> String {
+    match segment.find("<joint").and_then(|start| segment[start..].find("/>").map(|end| (start, start + end + 2))) {
+        Some((start, end)) => format!("{}{}", &segment[..start], &segment[end..]),
+        None => segment.to_string(),
+    }
+}
+
+/// A per-joint value derived from a per-length one, to 12 significant digits: the division and
+/// powers leave noise in the last bits (2e-4 came out as 1.9999999999999998e-4), and the grasp is
+/// sensitive enough that such a bit moved the crimper's rise time by 0.8 s; rounded, the default
+/// 8-link finger gets exactly the per-joint values it was calibrated with.
+fn per_joint(x: f64) -> f64 {
+    format!("{x:.11e}").parse().unwrap_or(x)
+}
+
 /// A model file without its leading comment (whose prose names the template's fields).
 fn body_of(text: &str) -> &str {
     text.split_once("-->").map_or(text, |(_, rest)| rest)
@@ -69,7 +88,14 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
     let l = f.segment_length_m();
     let r = f.thickness_m / 2.0;
     let seg_mass = f.density_kg_m3 * l * f.width_m * f.thickness_m;
-    let pad_seg = ((f.pad_position_m / l).floor() as usize).min(n - 1);
+    // The pad's casing is rigid: the strip cannot bend under it. A joint whose hinge falls under
+    // the casing is left out, so that stretch moves as one body whatever the number of links, and
+    // the pad goes on the segment where the casing starts (at 8 links it fits on one segment and no
+    // joint is left out; at 16 the joint at its centre is).
+    let half_pad = PAD_HALF_LENGTH_M;
+    let bends =
+        |i: usize| i == 0 || !(f.pad_position_m - half_pad..=f.pad_position_m + half_pad).contains(&(i as f64 * l));
+    let pad_seg = (((f.pad_position_m - half_pad) / l).floor() as usize).min(n - 1);
     let pad_x = f.pad_position_m - pad_seg as f64 * l;
     // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
     let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
@@ -84,18 +110,19 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
         ],
     )?;
     let segment_body = body_of(SEGMENT);
+    let rigid_body = without_joint(segment_body);
     let mut chain = String::new();
     for i in (0..n).rev() {
         chain = render(
-            segment_body,
+            if bends(i) { segment_body } else { &rigid_body },
             &[
                 ("i", i.to_string()),
                 ("x", num(if i == 0 { 0.0 } else { l })),
                 // Helix: each segment one step towards the flange (-z in the hand frame).
                 ("z", num(if i == 0 { 0.0 } else { -f.helix_slope * l })),
                 ("k_bend", num(f.bending_stiffness_n_m2 / l)),
-                ("d_bend", num(f.joint_damping_n_m_s)),
-                ("a_bend", num(f.joint_armature_kg_m2)),
+                ("d_bend", num(per_joint(f.bending_damping_n_m2_s / l))),
+                ("a_bend", num(per_joint(f.bending_armature_kg_m * l.powi(3)))),
                 ("max_curl", num(2.0)),
                 ("half_len", num(l / 2.0)),
                 ("half_width", num(f.width_m / 2.0)),
@@ -106,8 +133,10 @@ pub fn finger(f: &FingerConfig) -> Result<String, PhysicsError> {
             ],
         )?;
     }
-    let curl_terms: String =
-        (0..n).map(|i| format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(f.moment_arm_m))).collect();
+    let curl_terms: String = (0..n)
+        .filter(|&i| bends(i))
+        .map(|i| format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(f.moment_arm_m)))
+        .collect();
     let k = f.tendon_stiffness_n_m;
     let k_elastic = f.relaxed_fraction * k;
     let k_maxwell = (1.0 - f.relaxed_fraction) * k;

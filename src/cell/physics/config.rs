@@ -2,10 +2,10 @@
 //! the scene and of the engines that simulate it.
 
 use crate::scenario::{Checker, Validate};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// MuJoCo's integrator (`<option integrator>`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Integrator {
     /// Semi-implicit Euler (joint damping implicit).
@@ -19,7 +19,7 @@ pub enum Integrator {
 }
 
 /// Friction cone (`<option cone>`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Cone {
     /// Pyramidal approximation: creeps below the friction limit (see modeling.md).
@@ -30,7 +30,7 @@ pub enum Cone {
 
 /// Which engine simulates the scene (`physics.backend`). Both run the same scene, compiled once by
 /// MuJoCo from models/ (see [`super::rapier`] for how the rapier world is built from it).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Backend {
     /// MuJoCo 3.17 (soft contacts, elliptic cones, implicit integrators): the reference.
@@ -64,7 +64,7 @@ impl std::str::FromStr for Backend {
 
 /// rapier's friction constraints for contacts between two rigid bodies (contacts with the finger,
 /// a multibody, always use the Coulomb model in rapier 0.36).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RapierFriction {
     /// One friction constraint per group of contacts plus a twist constraint.
@@ -79,7 +79,7 @@ pub enum RapierFriction {
 ///
 /// Defaults chosen with tests/physics_validation.rs, which runs the analytic cases on both backends,
 /// and the facts measured for rapier 0.36 in ../shared/reference/modeling.md.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RapierConfig {
     /// Solver iterations per step. 8: 4 run 1.8x faster, but in the speed/accuracy study (crimper,
@@ -143,7 +143,7 @@ impl Validate for RapierConfig {
 }
 
 /// How the UR5e is simulated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ArmMode {
     /// Prescribed arm motion: each step the six joints get the velocities that take them to the
@@ -162,7 +162,7 @@ pub enum ArmMode {
 /// a small tolerance, then noslip iterations; modeling.md measured that pyramidal cones creep and a held
 /// box creeps without noslip) at the largest step that passes tests/physics_validation.rs, chosen for
 /// the full scene's speed (~100x real time, benches/physics.rs; models/README.md has the figures).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
     /// The engine (`mujoco` | `rapier`); `--backend` on the command line sets it too.
@@ -283,7 +283,7 @@ impl Validate for PhysicsConfig {
 /// choices for a flat TPU strip with a tendon, stated here, and the viscoelastic ones are meant to be
 /// tuned so the twin reproduces the paper's slip times without feedback (crimper ~10 s, shampoo ~13 s,
 /// hammer ~17 s after the arm starts moving).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FingerConfig {
     /// Number of strip segments (discretisation). 8: 17.5 mm segments, the 12 mm pad fits on one and a
@@ -305,14 +305,22 @@ pub struct FingerConfig {
     /// the wrap when its weight came on at lift-off and the pad chattered between 0 and 1 N (70-95 %
     /// of the crimper's setpoint); with 4e-4 the largest deviation is 8-28 %.
     pub bending_stiffness_n_m2: f64,
-    /// Bending damping per joint [N m s/rad]; a choice that damps the strip's free flapping in ~0.1 s.
-    pub joint_damping_n_m_s: f64,
-    /// Inertia added to each bending joint [kg m^2]. Numerical, not physical: MuJoCo's soft contacts are
-    /// as stiff as the effective mass behind them, and a 1 g segment sank up to 12 mm into the objects
-    /// (and tunnelled through the shampoo) at 5 ms; 1e-4 keeps penetration near 1 mm in every grasp tried
-    /// (modeling.md saw the same fix). Side effect: the strip's own curl mode has a period of ~0.6 s,
-    /// still much faster than the paper's 5 s force loop; it does not add inertia to the object.
-    pub joint_armature_kg_m2: f64,
+    /// Bending damping of the strip per unit length, the material's viscous (Kelvin-Voigt) part of
+    /// EI [N m^2 s]; each joint gets it / segment length [N m s/rad], as the stiffness does, so the
+    /// strip's damping does not change with the number of links. As a time constant, damping / EI.
+    /// TPU is a lossy elastomer (loss factor 0.1-0.3 at 1-10 Hz at room temperature, typical of
+    /// Shore 85-95A grades); see `bending_armature_kg_m` for why the value is set near critical.
+    pub bending_damping_n_m2_s: f64,
+    /// Inertia added to each bending joint, as a_joint = this x segment length^3 [kg/m -> kg m^2].
+    /// Numerical, not physical: MuJoCo's soft contacts are as stiff as the effective mass behind
+    /// them, and a bare 1 g segment sank up to 12 mm into the objects at 5 ms. A joint's armature
+    /// seen at the middle of its segment is a mass a / (l/2)^2 = 4 x this x l: with the cubic
+    /// scaling every segment brings the same contact mass per metre of strip, so the wrap's
+    /// contacts are as stiff per unit length at any number of links (a fixed armature per joint
+    /// made finer fingers' contacts stiffer and stiffer), and the added inertia vanishes as the
+    /// links get shorter. 18.6589 kg/m is 1e-4 kg m^2 per joint at 8 links (17.5 mm), the value that kept
+    /// penetration near 1 mm there.
+    pub bending_armature_kg_m: f64,
     /// Tendon offset from the strip's neutral axis \[m\] (moment arm of the tendon on each joint). 3 mm.
     pub moment_arm_m: f64,
     /// Instantaneous tendon-path stiffness K [N/m] (both SLS branches in parallel): tendon plus the soft
@@ -377,8 +385,8 @@ impl Default for FingerConfig {
             width_m: 0.02,
             density_kg_m3: 1200.0,
             bending_stiffness_n_m2: 4e-4,
-            joint_damping_n_m_s: 2e-4,
-            joint_armature_kg_m2: 1e-4,
+            bending_damping_n_m2_s: 3.5e-6,
+            bending_armature_kg_m: 18.658892128279884,
             moment_arm_m: 0.003,
             tendon_stiffness_n_m: 3000.0,
             relaxed_fraction: 0.05,
@@ -405,16 +413,18 @@ impl FingerConfig {
 
 impl Validate for FingerConfig {
     fn validate(&self, at: &mut Checker) {
-        at.require("segments", (2..=60).contains(&self.segments), || {
-            format!("must be between 2 and 60, got {}", self.segments)
+        // 128: four doublings of 8 links for the convergence study (1.1 mm segments on a 14 cm strip,
+        // finer than the strip's 2 mm thickness, so nothing finer describes the strip any better).
+        at.require("segments", (2..=128).contains(&self.segments), || {
+            format!("must be between 2 and 128, got {}", self.segments)
         });
         at.in_range("length_m", self.length_m, 0.02, 0.5);
         at.in_range("thickness_m", self.thickness_m, 2e-4, 0.02);
         at.positive("width_m", self.width_m);
         at.positive("density_kg_m3", self.density_kg_m3);
         at.non_negative("bending_stiffness_n_m2", self.bending_stiffness_n_m2);
-        at.non_negative("joint_damping_n_m_s", self.joint_damping_n_m_s);
-        at.non_negative("joint_armature_kg_m2", self.joint_armature_kg_m2);
+        at.non_negative("bending_damping_n_m2_s", self.bending_damping_n_m2_s);
+        at.non_negative("bending_armature_kg_m", self.bending_armature_kg_m);
         at.positive("moment_arm_m", self.moment_arm_m);
         at.positive("tendon_stiffness_n_m", self.tendon_stiffness_n_m);
         at.in_range("relaxed_fraction", self.relaxed_fraction, 0.0, 1.0);
@@ -441,7 +451,7 @@ impl Validate for FingerConfig {
 }
 
 /// Which of the paper's objects the scene holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ObjectName {
     /// Crimper with rubber handle, 351 g.
@@ -484,7 +494,7 @@ impl ObjectName {
 }
 
 /// `[object]`: which object, where it stands, and optional overrides.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ObjectConfig {
     /// The object (`crimper` | `hammer` | `shampoo`).

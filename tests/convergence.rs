@@ -1,0 +1,80 @@
+//! `tendril chart convergence` as a user calls it, on the CI-sized plan (one object, feedback on
+//! and off, the default against step/2 and links ×2): the files it writes, that its verdicts are
+//! the criteria applied to its own rows, and that its exit status says whether they hold.
+
+use std::collections::HashMap;
+
+mod common;
+use common::cli::{stderr, tendril};
+
+type Rows = Vec<HashMap<String, String>>;
+
+fn read(path: &std::path::Path) -> Rows {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
+    r.records().map(|rec| header.iter().cloned().zip(rec.unwrap().iter().map(str::to_string)).collect()).collect()
+}
+
+fn num(row: &HashMap<String, String>, key: &str) -> Option<f64> {
+    row[key].parse().ok()
+}
+
+#[test]
+fn the_quick_study_judges_its_own_rows_by_the_criteria() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tendril(&[
+        "chart",
+        "convergence",
+        "--quick",
+        "--seeds",
+        "1",
+        "--scenario",
+        "scenarios/crimper.toml",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    for f in ["convergence.csv", "convergence_criteria.csv", "convergence.png", "convergence.svg"] {
+        assert!(dir.path().join(f).is_file(), "{f} missing; {}", stderr(&out));
+    }
+    let rows = read(&dir.path().join("convergence.csv"));
+    let settings: Vec<(&str, &str, &str)> =
+        rows.iter().map(|r| (r["setting"].as_str(), r["timestep_s"].as_str(), r["segments"].as_str())).collect();
+    assert_eq!(settings.len(), 6, "two cases at three settings");
+    assert_eq!(&settings[..3], [("default", "0.005", "8"), ("step/2", "0.0025", "8"), ("links x2", "0.005", "16")]);
+    let verdicts = read(&dir.path().join("convergence_criteria.csv"));
+    assert_eq!(verdicts.len(), 4, "two cases, two pairs each");
+    let mut broken = 0;
+    for (v, pair) in verdicts.iter().zip([(0, 1), (0, 2), (3, 4), (3, 5)]) {
+        let (a, b) = (&rows[pair.0], &rows[pair.1]);
+        let same = a["outcome"] == b["outcome"] && a["drop_phase"] == b["drop_phase"];
+        assert_eq!(v["same_outcome"], same.to_string());
+        for (diff, col) in [("drop_time_diff_s", "drop_time_s"), ("fluctuation_diff_pp", "max_fluctuation_pct")] {
+            let expected = num(a, col).zip(num(b, col)).map(|(x, y)| (x - y).abs());
+            match (num(v, diff), expected) {
+                (Some(got), Some(want)) => assert!((got - want).abs() < 1e-9, "{diff}: {got} vs {want}"),
+                (got, want) => assert_eq!(got, want, "{diff}"),
+            }
+        }
+        let failed = v["failed"].as_str();
+        assert_eq!(v["converged"], failed.is_empty().to_string());
+        if num(v, "force_rmse_n").is_some_and(|e| e > 0.05) {
+            assert!(failed.contains("force RMSE"), "an RMSE over 0.05 N must break the criterion: {v:?}");
+        }
+        broken += usize::from(!failed.is_empty());
+    }
+    // The exit status and the summary line agree with the verdicts.
+    assert_eq!(out.status.success(), broken == 0, "{text}");
+    assert!(text.contains(&format!("convergence: {} of 4 comparisons meet the criteria", 4 - broken)), "{text}");
+}
+
+/// The CI criterion: the default converges against step/2 and links ×2. It does not yet
+/// (see README "Convergence"), so it is ignored until the model does; `cargo test -- --ignored`
+/// runs it.
+#[test]
+#[ignore = "the default model does not converge yet (README, Convergence)"]
+fn the_default_converges_against_step_over_two_and_links_times_two() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tendril(&["chart", "convergence", "--quick", "--seeds", "1", "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+}
