@@ -76,7 +76,7 @@ fn sigterm_stops_a_sweep_keeping_every_finished_row_whole() {
     std::fs::write(
         &sweep,
         format!(
-            "scenarios = ['{}']\n[grid]\nseed = [1, 2, 3, 4, 5, 6, 7, 8]\n'task.grasp_s' = [30.0]\n",
+            "scenarios = ['{}']\n[grid]\nseed = [1, 2, 3, 4, 5, 6, 7, 8]\n'task.grasp_s' = [120.0]\n",
             scenario.display()
         ),
     )
@@ -213,4 +213,48 @@ fn serve_stops_cleanly_on_sigterm() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert!(String::from_utf8_lossy(&out.stdout).contains("twin ran"), "the status is reported");
     assert!(stderr(&out).contains("SIGTERM: stopping cleanly"), "{}", stderr(&out));
+}
+
+/// A disk that fills mid-sweep (here a file-size limit, `ulimit -f`, with SIGXFSZ ignored so the
+/// write fails as on a full disk): a clear error, exit 1, the results file cut back to its whole
+/// rows; once there is room, `--resume` runs the rest and every row is whole.
+#[test]
+fn a_full_disk_mid_sweep_loses_nothing_and_resume_completes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = dir.path().join("sweep.toml");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml");
+    std::fs::write(
+        &sweep,
+        format!(
+            "scenarios = ['{}']\n[grid]\nseed = [1, 2, 3, 4, 5, 6]\n'task.grasp_s' = [3.0]\n'task.lift_s' = [1.0]\n\
+             'task.transfer_s' = [1.0]\n'task.lower_s' = [1.0]\n",
+            scenario.display()
+        ),
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    // 1 KiB: the header and a few rows fit, the sweep's six do not.
+    let limited = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f 2; exec '{}' sweep '{}' --out '{}' --threads 1",
+            env!("CARGO_BIN_EXE_tendril"),
+            sweep.display(),
+            out_dir.display()
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(limited.status.code(), Some(1), "{}", stderr(&limited));
+    assert!(stderr(&limited).contains("results.csv"), "{}", stderr(&limited));
+    let results = out_dir.join("results.csv");
+    let scan = tendril::sweep::durable::scan(&std::fs::read(&results).unwrap(), &results).unwrap();
+    assert_eq!(scan.torn_tail, None, "cut back to its whole rows");
+    assert!(scan.rows.len() < 6, "the limit was reached");
+
+    let out = tendril(&["sweep", sweep.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--resume"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let scan = tendril::sweep::durable::scan(&std::fs::read(&results).unwrap(), &results).unwrap();
+    let mut ids: Vec<usize> = scan.rows.iter().map(|r| r.run_id).collect();
+    ids.sort();
+    assert_eq!(ids, [0, 1, 2, 3, 4, 5], "no run lost, none twice");
 }

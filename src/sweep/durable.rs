@@ -25,12 +25,12 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum ResultsError {
     /// Reading or writing failed (a full disk, permissions).
-    #[error("{}: {source}", file.display())]
+    #[error("{}: {cause}", file.display())]
     Io {
         /// The file.
         file: PathBuf,
-        /// The underlying error.
-        source: std::io::Error,
+        /// The underlying error (not a `source`: the message holds it, and `{:#}` would repeat it).
+        cause: std::io::Error,
     },
     /// A fresh sweep would overwrite an existing results file.
     #[error("{} exists: pass --resume to continue it, or choose another --out", file.display())]
@@ -106,8 +106,8 @@ pub enum ResultsError {
 
 impl ResultsError {
     /// An IO error on `file`.
-    pub fn io(file: &Path, source: std::io::Error) -> ResultsError {
-        ResultsError::Io { file: file.to_path_buf(), source }
+    pub fn io(file: &Path, cause: std::io::Error) -> ResultsError {
+        ResultsError::Io { file: file.to_path_buf(), cause }
     }
 }
 
@@ -200,7 +200,7 @@ pub fn read_regular(path: &Path) -> Result<Vec<u8>, ResultsError> {
 
 /// Writes `bytes` over `path` atomically ([`crate::run::output::write_atomically`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ResultsError> {
-    crate::run::output::write_atomically(path, bytes).map_err(|(file, source)| ResultsError::Io { file, source })
+    crate::run::output::write_atomically(path, bytes).map_err(|(file, cause)| ResultsError::Io { file, cause })
 }
 
 /// What opening a results file found.
