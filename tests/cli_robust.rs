@@ -258,3 +258,30 @@ fn a_full_disk_mid_sweep_loses_nothing_and_resume_completes_it() {
     ids.sort();
     assert_eq!(ids, [0, 1, 2, 3, 4, 5], "no run lost, none twice");
 }
+
+/// A disk that fills during a run (a 16 KiB file-size limit, SIGXFSZ ignored): the trace's
+/// failure is reported (exit 1), the trace is cut back to its whole rows, summary.json is written
+/// and says why the run ended.
+#[test]
+fn a_full_disk_during_a_run_keeps_whole_trace_rows_and_reports_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml");
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f 32; exec '{}' run '{}' --set task.grasp_s=3 --out '{}'",
+            env!("CARGO_BIN_EXE_tendril"),
+            scenario.display(),
+            out_dir.display()
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("trace.csv: cannot write"), "{}", stderr(&out));
+    assert_whole_rows(&out_dir.join("trace.csv"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["outcome"], "error");
+    assert!(summary["error"].as_str().unwrap().contains("trace"), "{summary}");
+}
