@@ -245,24 +245,27 @@ fn a_loose_grip_lets_the_object_slip_out(backend: Backend) {
 
 #[test]
 fn objects_have_the_papers_masses() {
-    for name in [ObjectName::Crimper, ObjectName::Hammer, ObjectName::Shampoo] {
+    // The paper's masses (Sec. V), against what the model files give the compiled scene.
+    for (name, paper_kg) in [(ObjectName::Crimper, 0.351), (ObjectName::Hammer, 0.419), (ObjectName::Shampoo, 0.222)] {
         let spec = SceneSpec { object: Some(ObjectConfig { name, ..ObjectConfig::default() }), ..SceneSpec::default() };
         let sm = SceneModel::build(&spec).unwrap();
         let m = sm.model();
         let mass = m.body_mass()[body(m, "object")];
-        assert!((mass - name.paper_mass_kg()).abs() < 1e-9, "{name:?}: {mass} kg");
-        // The grip geometry Rust places by matches the model file, and the strip's whole helix (width,
-        // plus its rise over the full length) lies on the grip capsule's straight part.
+        assert!((mass - paper_kg).abs() < 1e-9, "{name:?}: {mass} kg");
+        let object = name.model().unwrap();
+        assert!((object.mass_kg - paper_kg).abs() < 1e-9, "{name:?}: the object model reads {} kg", object.mass_kg);
+        // The grip geometry the scene places by matches the compiled scene, and the strip's whole helix
+        // (width, plus its rise over the full length) lies on the grip capsule's straight part.
         let g = m.name_to_id(mjOBJ_GEOM, "object_grip").unwrap();
-        assert!((m.geom_size()[g][0] - name.grip_radius_m()).abs() < 1e-12, "{name:?} grip radius");
+        assert!((m.geom_size()[g][0] - object.grip_radius_m).abs() < 1e-12, "{name:?} grip radius");
         let (centre, half) = (m.geom_pos()[g][2], m.geom_size()[g][1]);
         let f = &spec.finger;
         let (low, high) = (
-            name.grip_height_m() - f.width_m / 2.0,
-            name.grip_height_m() + f.width_m / 2.0 + f.helix_slope * f.length_m,
+            object.wrap_height_m - f.width_m / 2.0,
+            object.wrap_height_m + f.width_m / 2.0 + f.helix_slope * f.length_m,
         );
         assert!(
-            low >= centre - half && high <= centre + half + name.grip_radius_m(),
+            low >= centre - half && high <= centre + half + object.grip_radius_m,
             "{name:?} helix {low}..{high} m off the grip"
         );
     }

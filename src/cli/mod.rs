@@ -49,6 +49,9 @@ enum Command {
     Bench(sensor::BenchArgs),
     /// Build the physics scene from a scenario and run a scripted grasp, printing the readout.
     PhysicsCheck(physics::PhysicsCheckArgs),
+    /// Write a scenario's assembled scene as one standalone MJCF (with a `start` keyframe) that
+    /// MuJoCo's own tools open.
+    Scene(physics::SceneArgs),
     /// Run the twin in real time behind the real devices' protocols (RTDE, URScript, a Dynamixel
     /// bus on a pseudo-terminal, HYPERION); loopback unless --bind says otherwise.
     Serve(serve::ServeArgs),
@@ -71,6 +74,7 @@ pub fn main() -> ExitCode {
         Command::Calibrate(a) => sensor::calibrate(a),
         Command::Bench(a) => sensor::bench(a),
         Command::PhysicsCheck(a) => physics::run(a),
+        Command::Scene(a) => physics::scene(a),
         Command::Serve(a) => serve::run(a),
         Command::Latency(a) => latency::run(a),
     };

@@ -23,3 +23,31 @@ pub fn run(a: PhysicsCheckArgs) -> anyhow::Result<ExitCode> {
     crate::cell::physics::check::run(&s)?;
     Ok(ExitCode::SUCCESS)
 }
+
+/// Arguments of `tendril scene`.
+#[derive(Debug, clap::Args)]
+pub struct SceneArgs {
+    /// Pick-and-place scenario whose scene to export.
+    scenario: PathBuf,
+    /// Overrides `key=value`, checked like the file (e.g. `finger.segments=16`).
+    #[arg(long = "set")]
+    set: Vec<Override>,
+    /// Where to write the MJCF.
+    #[arg(long, default_value = "scene.xml")]
+    out: PathBuf,
+}
+
+/// `tendril scene`: the assembled scene as one MJCF MuJoCo's own tools open, with the start state
+/// as keyframe `start`.
+pub fn scene(a: SceneArgs) -> anyhow::Result<ExitCode> {
+    let s: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&a.scenario, &a.set)?;
+    let model = crate::cell::physics::SceneModel::build(&s.scene_spec())?;
+    let xml = crate::cell::physics::export::standalone_xml(&model)?;
+    std::fs::write(&a.out, xml).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", a.out.display()))?;
+    super::emit(&format!(
+        "wrote {} (keyframe `start`: python -m mujoco.viewer --mjcf {})\n",
+        a.out.display(),
+        a.out.display()
+    ));
+    Ok(ExitCode::SUCCESS)
+}

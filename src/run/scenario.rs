@@ -176,7 +176,8 @@ impl PickPlaceScenario {
         RunIdentity {
             scenario: self.name.clone(),
             object: self.object.name.to_string(),
-            mass_kg: self.object.name.paper_mass_kg(),
+            // From the object's model file (NaN only if it does not load, when no run can start).
+            mass_kg: self.object.name.model().map_or(f64::NAN, |m| m.mass_kg),
             feedback: self.feedback,
             gains: Gains { kp: self.controller.kp, ki: self.controller.ki, kd: self.controller.kd },
             setpoint_n: self.setpoint_n,

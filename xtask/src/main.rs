@@ -121,8 +121,10 @@ fn run_tests(extra: &[String]) -> Result<(), String> {
 
 /// Independent protocol clients the tests run against the virtual devices (tests/python_clients.rs),
 /// pinned: SDU `ur_rtde` (a cp311 manylinux wheel, so the venv needs Python 3.11) and ROBOTIS
-/// `dynamixel-sdk` with its one dependency. Installed once into `vendor/venv`; returns its python.
-const PYTHON_CLIENTS: [&str; 3] = ["ur_rtde==1.6.5", "dynamixel-sdk==4.1.0", "pyserial==3.5"];
+/// `dynamixel-sdk` with its one dependency; and MuJoCo's own Python package, which opens the scene
+/// `tendril scene` exports (tests/scene_export.rs). Installed once into `vendor/venv`; returns its
+/// python.
+const PYTHON_CLIENTS: [&str; 4] = ["ur_rtde==1.6.5", "dynamixel-sdk==4.1.0", "pyserial==3.5", "mujoco==3.17.0"];
 
 fn python_clients() -> Result<PathBuf, String> {
     let venv = workspace_root().join("vendor/venv");

@@ -1,6 +1,7 @@
 //! Assembles a scene's MJCF from the parts in models/ and the scenario's values.
 
 use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig};
+use super::object::ObjectModel;
 use super::template::{num, nums, render, section};
 use super::{PhysicsError, SceneSpec, ur5e};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -180,19 +181,19 @@ pub struct Placement {
 }
 
 /// Computes the start placement: the hand from forward kinematics of the start joint angles; the
-/// object (unless its position is given) against the palm ([`PALM_GAP_M`]) and so far beside the strip
+/// object (unless its position is given; its grip radius and wrap height from its model) against the palm ([`PALM_GAP_M`]) and so far beside the strip
 /// that the growing strip's pad passes it with [`GROW_CLEARANCE_M`] to spare; the table under
 /// the object so that the strip's plane crosses the middle of the grip.
-pub fn placement(spec: &SceneSpec) -> Placement {
+pub fn placement(spec: &SceneSpec, object: Option<&ObjectModel>) -> Placement {
     let hand = ur5e::forward(&spec.arm_q0);
     let f = &spec.finger;
-    let Some(obj) = &spec.object else {
+    let (Some(obj), Some(model)) = (&spec.object, object) else {
         return Placement { hand, object: None, table_z: 0.0 };
     };
-    let radius = obj.name.grip_radius_m();
+    let radius = model.grip_radius_m;
     let y = f.thickness_m / 2.0 + f.pad_protrusion_m + GROW_CLEARANCE_M + radius;
     let wrap = hand * Point3::new(radius + PALM_GAP_M, y, f.exit_z_m);
-    let base_z = wrap.z - obj.name.grip_height_m();
+    let base_z = wrap.z - model.wrap_height_m;
     let (x, y) = match obj.position_m {
         Some([x, y]) => (x, y),
         None => (wrap.x, wrap.y),
@@ -202,7 +203,8 @@ pub fn placement(spec: &SceneSpec) -> Placement {
 
 /// The full scene MJCF for `spec`, and where its parts start.
 pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
-    let place = placement(spec);
+    let object = spec.object.as_ref().map(|o| o.name.model()).transpose()?;
+    let place = placement(spec, object.as_ref());
     let mut worldbody = String::new();
     let mut actuator = String::new();
     let mut tendon = String::new();
@@ -211,7 +213,7 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     if spec.object.is_some() {
         let table = TABLE.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
         worldbody.push_str(section(&table, "worldbody"));
-        worldbody.push_str(section(spec.object.as_ref().map(|o| o.name.mjcf()).unwrap_or(""), "worldbody"));
+        worldbody.push_str(section(object.as_ref().map_or("", |o| o.mjcf.as_str()), "worldbody"));
     }
     // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
     // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.

@@ -483,13 +483,9 @@ impl ObjectName {
         }
     }
 
-    /// Mass from the paper (Sec. V) \[kg\].
-    pub fn paper_mass_kg(self) -> f64 {
-        match self {
-            ObjectName::Crimper => 0.351,
-            ObjectName::Hammer => 0.419,
-            ObjectName::Shampoo => 0.222,
-        }
+    /// The object's model, read from its file (mass, grip radius, wrap height).
+    pub fn model(self) -> Result<super::object::ObjectModel, super::PhysicsError> {
+        super::object::ObjectModel::from_mjcf(&self.to_string(), self.mjcf())
     }
 }
 
@@ -524,27 +520,6 @@ impl Validate for ObjectConfig {
             at.require("position_m", x.is_finite() && y.is_finite() && x.abs() <= 1.0 && y.abs() <= 1.0, || {
                 format!("x and y must lie within ±1 m of the arm's base (UR5e reach 0.85 m), got [{x}, {y}]")
             });
-        }
-    }
-}
-
-impl ObjectName {
-    /// Radius of the grip capsule the finger wraps \[m\] (models/objects/*.xml, `object_grip`).
-    pub fn grip_radius_m(self) -> f64 {
-        match self {
-            ObjectName::Crimper => 0.0125,
-            ObjectName::Hammer => 0.014,
-            ObjectName::Shampoo => 0.012,
-        }
-    }
-
-    /// Height above the object's footprint at which the strip leaves the guide and starts its first
-    /// turn \[m\]; the helix rises from there, along the grip capsule (models/objects/*.xml).
-    pub fn grip_height_m(self) -> f64 {
-        match self {
-            ObjectName::Crimper => 0.1,
-            ObjectName::Hammer => 0.13,
-            ObjectName::Shampoo => 0.162,
         }
     }
 }

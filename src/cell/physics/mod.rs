@@ -9,12 +9,16 @@
 //!   model and its run ([`rapier::RapierScene`]).
 //! - [`drive`]: motor speed limits, the kinematic arm's interpolation and the grip-in-hand
 //!   readout, shared by both backends.
+//! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
+//! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
 //! - [`ur5e`]: DH kinematics.
 
 pub mod check;
 pub mod compose;
 pub mod config;
 pub mod drive;
+pub mod export;
+pub mod object;
 pub mod rapier;
 pub mod scene;
 pub mod template;
@@ -143,6 +147,14 @@ pub enum PhysicsError {
         what: &'static str,
         /// The value given.
         value: f64,
+    },
+    /// An object's model file breaks the object contract (see [`object`]).
+    #[error("object model {file}: {what}")]
+    Object {
+        /// The shipped object's name or the file.
+        file: String,
+        /// What is wrong or missing.
+        what: String,
     },
     /// An element the scene needs is missing from the model (a bug between models/ and scene.rs).
     #[error("model has no {kind} named `{name}`")]

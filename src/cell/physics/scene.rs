@@ -244,7 +244,7 @@ pub struct Scene {
 
 /// Armature of the arm joints in the kinematic mode [kg m^2]: large enough that a few newtons of
 /// contact force do not turn a joint within a step (their motion is prescribed anyway).
-const KINEMATIC_ARM_ARMATURE: f64 = 1000.0;
+pub(crate) const KINEMATIC_ARM_ARMATURE: f64 = 1000.0;
 
 /// MuJoCo warnings that mean the run is not trustworthy.
 const FATAL_WARNINGS: [(mjtWarning, &str); 6] = [
