@@ -97,6 +97,14 @@ pub enum CellError {
     /// Set-up failed (scene could not be built, device not found...).
     #[error("configure: {0}")]
     Configure(String),
+    /// An operator stop (Ctrl-C, SIGTERM, SIGHUP; see [`crate::interrupt`]) ended the run.
+    #[error("stopped by {signal} at t = {time_s:.3} s")]
+    Stopped {
+        /// The signal's name.
+        signal: &'static str,
+        /// Cell time of the stop \[s\].
+        time_s: f64,
+    },
 }
 
 /// A gripping cell: arm, gripper motors and interrogator behind one lifecycle.

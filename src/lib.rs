@@ -16,6 +16,8 @@
 //! - [`control`]: what runs the same on the twin and on the real cell.
 //! - [`calibration`]: the paper's calibration procedures, for simulated or recorded bench data.
 //! - [`reproduce`]: the paper's figures next to the twin's.
+//! - [`mujoco_log`]: MuJoCo's warnings into our log and summaries (no `MUJOCO_LOG.TXT`).
+//! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
 //! - [`signals`]: the data types that cross the seam (wavelengths, ...).
 
 #![warn(missing_docs)]
@@ -25,6 +27,8 @@ pub mod cell;
 pub mod cli;
 pub mod control;
 pub mod hardware;
+pub mod interrupt;
+pub mod mujoco_log;
 pub mod plot;
 pub mod reproduce;
 pub mod run;

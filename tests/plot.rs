@@ -407,3 +407,38 @@ fn stability_per_backend() {
     let svg = std::fs::read_to_string(dir.join("stability.svg")).unwrap();
     assert!(svg.contains("rapier / RK4") && svg.contains("mujoco / Euler"));
 }
+
+/// Issue 18: a trace whose force column is all NaN, or holds 1e308, is refused, not drawn.
+#[test]
+fn a_force_column_without_drawable_values_is_refused() {
+    let (_keep, dir) = workdir("nonfinite");
+    let trace = dir.join("trace.csv");
+    // Column 6 is force_n.
+    let with_force = |value: &dyn Fn(usize) -> String| {
+        write_run(&dir, false, 100);
+        let text = std::fs::read_to_string(&trace).unwrap();
+        let lines: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i == 0 {
+                    return l.to_string();
+                }
+                let mut cells: Vec<String> = l.split(',').map(String::from).collect();
+                cells[5] = value(i);
+                cells.join(",")
+            })
+            .collect();
+        std::fs::write(&trace, lines.join("\n") + "\n").unwrap();
+    };
+    with_force(&|_| "NaN".into());
+    let e = plot::plot_path(&dir, None).unwrap_err().to_string();
+    assert!(e.contains("trace.csv") && e.contains("`force_n` has no finite value"), "{e}");
+    with_force(&|i| if i == 7 { "1e308".into() } else { "0.5".into() });
+    let e = plot::plot_path(&dir, None).unwrap_err().to_string();
+    assert!(e.contains("trace.csv:8:") && e.contains("force_n") && e.contains("beyond"), "{e}");
+    with_force(&|i| if i == 7 { "inf".into() } else { "0.5".into() });
+    assert!(plot::plot_path(&dir, None).is_err());
+    with_force(&|_| "0.5".into());
+    assert!(plot::plot_path(&dir, None).is_ok(), "a flat, finite trace draws");
+}

@@ -235,3 +235,34 @@ fn active_cell(port_base: u16, tune: impl FnOnce(&mut RealCellConfig)) -> (Serve
     cell.activate().unwrap();
     (serve, cell)
 }
+
+/// Issue 18: RTDE and HYPERION command connections that stay silent are closed after the idle
+/// timeout (30 s by default, 300 ms here); one that keeps talking stays open.
+#[test]
+fn idle_command_connections_are_closed() {
+    let _turn = one_at_a_time();
+    use std::io::{Read, Write};
+    let mut config = ServeConfig::loopback().with_port_base(39780);
+    config.idle_timeout = std::time::Duration::from_millis(300);
+    let serve = start(&short_lift(&[]), &config).unwrap();
+    let mut buf = [0u8; 64];
+    for addr in [serve.addrs[0], serve.addrs[2]] {
+        let mut s = std::net::TcpStream::connect(addr).unwrap();
+        s.set_read_timeout(Some(std::time::Duration::from_secs(5))).unwrap();
+        let started = std::time::Instant::now();
+        assert_eq!(s.read(&mut buf).unwrap_or(usize::MAX), 0, "{addr}: an idle connection must be closed");
+        let waited = started.elapsed().as_secs_f64();
+        assert!((0.25..3.0).contains(&waited), "{addr}: closed after {waited} s");
+    }
+    // An RTDE client that asks for the protocol version every 100 ms keeps its connection.
+    let mut s = std::net::TcpStream::connect(serve.addrs[0]).unwrap();
+    s.set_read_timeout(Some(std::time::Duration::from_secs(2))).unwrap();
+    for _ in 0..8 {
+        s.write_all(&[0x00, 0x05, 0x56, 0x00, 0x02]).unwrap();
+        let mut reply = [0u8; 4];
+        s.read_exact(&mut reply).unwrap();
+        assert_eq!(reply, [0x00, 0x04, 0x56, 0x01]);
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    serve.stop().unwrap();
+}

@@ -201,3 +201,41 @@ fn serve_and_run_reject_a_bad_hardware_key_naming_file_and_key() {
         assert!(!err.contains("panicked"), "{err}");
     }
 }
+
+/// SIGTERM on the real path does what Ctrl-C does (issue 18): the safe stop, `summary.json`
+/// written with the stop as its error, the trace's rows whole; exit 128 + 15.
+#[test]
+fn sigterm_on_the_real_path_stops_safely_and_keeps_both_files() {
+    let _turn = one_at_a_time();
+    let dir = tempfile::tempdir().unwrap();
+    let (server, base, pty) = serve(&[]);
+    let watchdog_ms = (LOOSE_WATCHDOG_S * 1e3).to_string();
+    let child = tendril_command()
+        .args(["run", SHORT_LIFT, "--hardware", "real", "--port-base", &base.to_string(), "--dxl"])
+        .arg(&pty)
+        .args(["--sensor-stale-samples", &watchdog_ms, "--arm-stale-ms", &watchdog_ms])
+        .args(["--dxl-timeout-ms", &watchdog_ms])
+        .arg("--out")
+        .arg(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("tendril runs");
+    // Well into the run (about 15 s of cell time), after the devices are configured.
+    std::thread::sleep(Duration::from_secs(4));
+    // SAFETY: plain kill(2) of the child we spawned, which has not been reaped yet.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(child.wait_with_output());
+    });
+    let out = rx.recv_timeout(Duration::from_secs(20)).expect("stopped within 20 s").unwrap();
+    drop(server);
+    assert_eq!(out.status.code(), Some(143), "{}", describe(&out));
+    let s = summary(dir.path());
+    assert_eq!(s["backend"], "real");
+    assert!(s["error"].as_str().is_some_and(|e| e.contains("stopped by SIGTERM")), "{s}");
+    let trace = std::fs::read_to_string(dir.path().join("trace.csv")).unwrap();
+    assert!(trace.ends_with('\n') && trace.lines().all(|l| l.split(',').count() == 16), "a torn row");
+    assert!(trace.lines().count() > 100, "the rows before the stop are kept");
+}

@@ -16,6 +16,28 @@ pub enum FitError {
     /// The normal equations are singular (all x equal, for example).
     #[error("the data do not determine the fit (singular design: are all x values equal?)")]
     Singular,
+    /// A value is NaN, infinite or so large that its square overflows.
+    #[error("{what} holds a non-finite value or one beyond ±{MAX_FIT_MAGNITUDE:e}")]
+    NonFinite {
+        /// Which input: `x`, `y` or `design`.
+        what: &'static str,
+    },
+    /// The SVD did not converge within `MAX_SVD_ITERATIONS` (10 000) iterations.
+    #[error("the least-squares solution did not converge within {MAX_SVD_ITERATIONS} iterations")]
+    NoConvergence,
+}
+
+/// Largest magnitude of any input to a fit. Why: the squares and products the SVD forms must stay
+/// far from overflow (1e150² is 1e300, near `f64::MAX` 1.8e308); the calibration's inputs are
+/// forces of a few newtons and shifts of a few thousand pm, so 1e100 refuses only garbage.
+pub const MAX_FIT_MAGNITUDE: f64 = 1e100;
+
+/// Iteration bound of the SVD: nalgebra's unbounded default spun forever on values near 1e160;
+/// well-conditioned 3-column designs converge in tens of iterations.
+pub const MAX_SVD_ITERATIONS: usize = 10_000;
+
+fn all_sane(values: impl IntoIterator<Item = f64>) -> bool {
+    values.into_iter().all(|v| v.is_finite() && v.abs() <= MAX_FIT_MAGNITUDE)
 }
 
 /// A polynomial fit `y = Σ coefᵢ·xⁱ` with its quality.
@@ -42,11 +64,18 @@ pub fn least_squares(design: &DMatrix<f64>, y: &[f64]) -> Result<Vec<f64>, FitEr
     if n < k || n != y.len() {
         return Err(FitError::TooFewPoints { need: k, got: n.min(y.len()) });
     }
+    if !all_sane(design.iter().copied()) {
+        return Err(FitError::NonFinite { what: "design" });
+    }
+    if !all_sane(y.iter().copied()) {
+        return Err(FitError::NonFinite { what: "y" });
+    }
     // Column scaling keeps the normal equations well conditioned for x up to a few thousand.
     let scales: Vec<f64> = (0..k).map(|j| design.column(j).amax().max(1e-300)).collect();
     let scaled = DMatrix::from_fn(n, k, |i, j| design[(i, j)] / scales[j]);
     let yv = DVector::from_column_slice(y);
-    let svd = scaled.svd(true, true);
+    let svd =
+        nalgebra::SVD::try_new(scaled, true, true, f64::EPSILON, MAX_SVD_ITERATIONS).ok_or(FitError::NoConvergence)?;
     let max_sv = svd.singular_values.max();
     if max_sv.is_nan() || max_sv <= 0.0 || svd.singular_values.min() < 1e-10 * max_sv {
         return Err(FitError::Singular);
@@ -59,6 +88,10 @@ pub fn least_squares(design: &DMatrix<f64>, y: &[f64]) -> Result<Vec<f64>, FitEr
 pub fn poly_fit(x: &[f64], y: &[f64], degree: usize) -> Result<PolyFit, FitError> {
     if x.len() != y.len() || x.len() <= degree {
         return Err(FitError::TooFewPoints { need: degree + 1, got: x.len().min(y.len()) });
+    }
+    // Checked before the powers are formed: x = 1e160 squared is infinite.
+    if !all_sane(x.iter().copied()) {
+        return Err(FitError::NonFinite { what: "x" });
     }
     let design = DMatrix::from_fn(x.len(), degree + 1, |i, j| x[i].powi(j as i32));
     let coefficients = least_squares(&design, y)?;
@@ -93,5 +126,21 @@ mod tests {
     fn refuses_degenerate_data() {
         assert!(matches!(poly_fit(&[1.0, 1.0, 1.0, 1.0], &[1.0, 2.0, 3.0, 4.0], 1), Err(FitError::Singular)));
         assert!(matches!(poly_fit(&[1.0], &[1.0], 2), Err(FitError::TooFewPoints { .. })));
+    }
+
+    #[test]
+    fn huge_values_fail_fast_instead_of_spinning() {
+        let x = [0.0, 1.0, 2.0, 1e160];
+        let started = std::time::Instant::now();
+        assert_eq!(poly_fit(&x, &[0.0, 1.0, 2.0, 3.0], 2), Err(FitError::NonFinite { what: "x" }));
+        assert_eq!(
+            poly_fit(&[0.0, 1.0, 2.0, 3.0], &[0.0, 1.0, f64::NAN, 3.0], 1),
+            Err(FitError::NonFinite { what: "y" })
+        );
+        // Within bounds but badly scaled: an answer or an error, never a hang.
+        for big in [1e50, 1e99] {
+            let _ = poly_fit(&[0.0, 1.0, 2.0, big], &[0.0, 1.0, 2.0, 3.0], 2);
+        }
+        assert!(started.elapsed().as_secs_f64() < 5.0);
     }
 }

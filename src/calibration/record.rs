@@ -17,6 +17,22 @@ use std::path::{Path, PathBuf};
 /// The column header a bench CSV must start with.
 pub const CSV_HEADER: &str = "time_s,load_cell_n,fbg1_nm,fbg2_nm,temperature_c";
 
+/// Accepted range of each column, in the column's unit, and why. A value outside is a recording
+/// fault (or a hostile file), and refusing it here keeps the fits well scaled: values of 1e160
+/// once made the least-squares SVD spin.
+pub const COLUMN_BOUNDS: [(&str, f64, f64); 5] = [
+    // A bench run of up to a week (the paper's longest is minutes).
+    ("time_s", 0.0, 7.0 * 86_400.0),
+    // Twenty times the sensor's 4.69 N range (paper Sec. IV-B): a load cell pressing the soft pad
+    // harder than that has torn it; negative to -100 N for a load cell's offset or pull.
+    ("load_cell_n", -100.0, 100.0),
+    // Well outside every interrogator's band (HYPERION si255: 1460-1620 nm).
+    ("fbg1_nm", 1000.0, 2000.0),
+    ("fbg2_nm", 1000.0, 2000.0),
+    // The fibre's acrylate coating fails above ~85 °C; -100 to 300 °C spans every bench.
+    ("temperature_c", -100.0, 300.0),
+];
+
 /// One recorded sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BenchRow {
@@ -81,7 +97,13 @@ pub enum CsvError {
 impl BenchRecord {
     /// Reads a bench CSV (see the module docs for the columns).
     pub fn read_csv(file: &Path) -> Result<BenchRecord, CsvError> {
-        let text = std::fs::read_to_string(file).map_err(|source| CsvError::Io { file: file.into(), source })?;
+        let bytes = std::fs::read(file).map_err(|source| CsvError::Io { file: file.into(), source })?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+            let column = valid.len() - valid.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1) + 1;
+            CsvError::Row { file: file.into(), line, reason: format!("column {column}: not UTF-8 text") }
+        })?;
         BenchRecord::parse_csv(&text, file)
     }
 
@@ -97,7 +119,7 @@ impl BenchRecord {
         if normalized != CSV_HEADER {
             return Err(CsvError::Header { file: file.into(), line: hline, got: header.to_string() });
         }
-        let mut rows = Vec::new();
+        let mut rows: Vec<BenchRow> = Vec::new();
         let mut last_time = f64::NEG_INFINITY;
         for (line, text) in lines {
             let row_err = |reason: String| CsvError::Row { file: file.into(), line, reason };
@@ -105,29 +127,58 @@ impl BenchRecord {
             if cells.len() != 5 {
                 return Err(row_err(format!("expected 5 columns, got {}", cells.len())));
             }
-            let num = |i: usize, name: &str| -> Result<f64, CsvError> {
+            let num = |i: usize| -> Result<f64, CsvError> {
+                let (name, lo, hi) = COLUMN_BOUNDS[i];
                 let v: f64 =
                     cells[i].parse().map_err(|_| row_err(format!("`{name}`: `{}` is not a number", cells[i])))?;
-                if v.is_finite() { Ok(v) } else { Err(row_err(format!("`{name}`: {v} is not finite"))) }
+                if !v.is_finite() {
+                    return Err(row_err(format!("`{name}`: {v} is not finite")));
+                }
+                if !(lo..=hi).contains(&v) {
+                    return Err(row_err(format!("`{name}`: {v} is outside [{lo}, {hi}]")));
+                }
+                Ok(v)
             };
-            let opt = |i: usize, name: &str| -> Result<Option<f64>, CsvError> {
-                if cells[i].is_empty() { Ok(None) } else { num(i, name).map(Some) }
+            let opt = |i: usize| -> Result<Option<f64>, CsvError> {
+                if cells[i].is_empty() { Ok(None) } else { num(i).map(Some) }
             };
             let row = BenchRow {
-                time_s: num(0, "time_s")?,
-                load_cell_n: opt(1, "load_cell_n")?,
-                fbg1_nm: num(2, "fbg1_nm")?,
-                fbg2_nm: num(3, "fbg2_nm")?,
-                temperature_c: opt(4, "temperature_c")?,
+                time_s: num(0)?,
+                load_cell_n: opt(1)?,
+                fbg1_nm: num(2)?,
+                fbg2_nm: num(3)?,
+                temperature_c: opt(4)?,
             };
             if row.time_s < last_time {
                 return Err(row_err(format!("`time_s` goes back in time ({} after {last_time})", row.time_s)));
             }
+            // A reference column is recorded on every row or on none: a single empty cell is a
+            // lost reading, not a bench without that instrument.
+            if let Some(first) = rows.first() {
+                for (name, had, has) in [
+                    ("load_cell_n", first.load_cell_n.is_some(), row.load_cell_n.is_some()),
+                    ("temperature_c", first.temperature_c.is_some(), row.temperature_c.is_some()),
+                ] {
+                    if had != has {
+                        let state = if has { "has a value" } else { "is empty" };
+                        return Err(row_err(format!(
+                            "`{name}` {state} here but not on the first data row: the column must be filled on every row or on none"
+                        )));
+                    }
+                }
+            }
             last_time = row.time_s;
             rows.push(row);
         }
-        if rows.is_empty() {
+        let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
             return Err(CsvError::Empty { file: file.into() });
+        };
+        if rows.len() > 1 && last.time_s <= first.time_s {
+            return Err(CsvError::Row {
+                file: file.into(),
+                line: hline + 1,
+                reason: format!("`time_s` never advances (every row at {} s): not a recording over time", first.time_s),
+            });
         }
         Ok(BenchRecord { rows })
     }
@@ -174,11 +225,11 @@ mod tests {
                     load_cell_n: Some(0.01),
                     fbg1_nm: 1540.001,
                     fbg2_nm: 1550.0,
-                    temperature_c: None,
+                    temperature_c: Some(25.25),
                 },
                 BenchRow {
                     time_s: 0.01,
-                    load_cell_n: None,
+                    load_cell_n: Some(1.5),
                     fbg1_nm: 1540.5,
                     fbg2_nm: 1550.002,
                     temperature_c: Some(25.5),
@@ -198,5 +249,26 @@ mod tests {
         assert!(err.to_string().contains("line 2: expected 5 columns"), "{err}");
         let err = BenchRecord::parse_csv("a,b\n", Path::new("b.csv")).unwrap_err();
         assert!(matches!(err, CsvError::Header { line: 1, .. }));
+    }
+
+    #[test]
+    fn huge_frozen_and_gappy_records_are_refused() {
+        let parse = |body: &str| BenchRecord::parse_csv(&format!("{CSV_HEADER}\n{body}"), Path::new("b.csv"));
+        let err = parse("0,0,1540,1550,\n0.1,1e160,1540,1550,\n").unwrap_err().to_string();
+        assert!(err.contains("line 3") && err.contains("load_cell_n") && err.contains("outside"), "{err}");
+        let err = parse("0,0,1540,1550,\n0,1,1540,1550,\n0,2,1540,1550,\n").unwrap_err().to_string();
+        assert!(err.contains("never advances"), "{err}");
+        let err = parse("0,0,1540,1550,\n0.1,,1540,1550,\n").unwrap_err().to_string();
+        assert!(err.contains("line 3") && err.contains("`load_cell_n` is empty"), "{err}");
+        let err = parse("0,0,1540,1e9,\n").unwrap_err().to_string();
+        assert!(err.contains("fbg2_nm"), "{err}");
+        assert!(parse("0,,1540,1550,\n0.1,,1540,1550,\n").is_ok());
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("b.csv");
+        let mut bytes = format!("{CSV_HEADER}\n0,0,15").into_bytes();
+        bytes.extend_from_slice(b"\xff40,1550,\n");
+        std::fs::write(&f, bytes).unwrap();
+        let err = BenchRecord::read_csv(&f).unwrap_err().to_string();
+        assert!(err.contains("b.csv: line 2") && err.contains("column 7: not UTF-8"), "{err}");
     }
 }

@@ -24,8 +24,8 @@ pub struct ChartArgs {
     #[arg(long)]
     quick: bool,
     /// Worker threads for the studies that do not time runs (convergence, stability, gain-map);
-    /// 0: one per core.
-    #[arg(long, default_value_t = 0)]
+    /// 0: one per core, at most 1024.
+    #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
     /// Convergence: the seeds of every case.
     #[arg(long, value_delimiter = ',', default_values_t = [1u64, 2, 3])]

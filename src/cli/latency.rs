@@ -42,8 +42,16 @@ pub struct LatencyArgs {
 }
 
 pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
-    anyhow::ensure!(a.seconds > 0.0 && a.seconds <= 3600.0, "--seconds must be in (0, 3600]");
-    anyhow::ensure!(a.rate_hz > 0.0 && a.rate_hz <= 2000.0, "--rate-hz must be in (0, 2000]");
+    anyhow::ensure!(a.seconds > 0.0 && a.seconds <= 3600.0, "--seconds must be in (0, 3600], got {}", a.seconds);
+    // At least 1 Hz, and at least ten ticks in the measurement: at 0.001 Hz the first tick's wait
+    // alone was 1000 s, and the command printed nothing for as long.
+    anyhow::ensure!(a.rate_hz >= 1.0 && a.rate_hz <= 2000.0, "--rate-hz must be in [1, 2000], got {}", a.rate_hz);
+    anyhow::ensure!(
+        a.rate_hz * a.seconds >= 10.0,
+        "--seconds {} at --rate-hz {} gives fewer than 10 ticks to measure",
+        a.seconds,
+        a.rate_hz
+    );
     anyhow::ensure!(
         a.sensor_stale_samples.is_finite() && a.sensor_stale_samples >= 1.0,
         "--sensor-stale-samples must be at least 1"

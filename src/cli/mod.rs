@@ -61,6 +61,8 @@ enum Command {
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
 pub fn main() -> ExitCode {
+    // SAFETY: first thing, before any thread exists that could use MuJoCo.
+    unsafe { crate::mujoco_log::install() };
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Reproduce(a) => reproduce::run(a),
@@ -76,24 +78,74 @@ pub fn main() -> ExitCode {
         Command::Serve(a) => serve::run(a),
         Command::Latency(a) => latency::run(a),
     };
-    match result {
+    let code = match result {
         Ok(code) => code,
         Err(e) => {
             eprintln!("tendril: {e:#}");
+            return ExitCode::FAILURE;
+        }
+    };
+    // Output that could not be written (`> /dev/full`) is a failure, reported here once.
+    let flushed = std::io::stdout().lock().flush();
+    match STDOUT_ERROR
+        .get()
+        .cloned()
+        .or(flushed.err().filter(|e| e.kind() != std::io::ErrorKind::BrokenPipe).map(|e| e.to_string()))
+    {
+        Some(e) => {
+            eprintln!("tendril: standard output: cannot write: {e}");
             ExitCode::FAILURE
         }
+        None => code,
     }
 }
 
+/// The first error writing standard output, other than a closed pipe.
+static STDOUT_ERROR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
 /// Writes to standard output; a closed pipe (`tendril ... | head`) ends output quietly instead
-/// of panicking as `print!` would.
+/// of panicking as `print!` would; any other write error (a full disk) is kept and makes
+/// [`main`] exit non-zero.
 fn emit(text: &str) {
-    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes())
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        let _ = STDOUT_ERROR.set(e.to_string());
+    }
 }
 
-/// Writes `text` to `path`, naming the file in the error.
+/// Writes `text` to `path` atomically (a failure keeps the previous file), naming the file in the
+/// error.
 fn write_file(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
-    std::fs::write(path, text).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+    crate::run::output::write_atomically(path, text.as_bytes())
+        .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
+}
+
+/// Longest duration a `--seconds` argument accepts \[s\]: a week, longer than any session on the
+/// cell; NaN, infinities and negative values are refused.
+pub const MAX_SECONDS: f64 = 7.0 * 86_400.0;
+
+/// Parses a `--seconds` value: finite, > 0 and at most [`MAX_SECONDS`].
+fn seconds_arg(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_SECONDS => Ok(v),
+        _ => Err(format!("must be a number of seconds in (0, {MAX_SECONDS}], got {s}")),
+    }
+}
+
+/// Exit code of a run or sweep in which a run ended with outcome `error` (diverged physics, a
+/// device fault): everything was written, but not every run completed. Distinct from 1 (nothing
+/// or not everything could be done: bad input, a write error) so scripts can tell them apart.
+pub const EXIT_RUN_ERROR: u8 = 3;
+
+/// The exit code of a command that ran scenarios: `128 + signal` if an operator stop ended it,
+/// [`EXIT_RUN_ERROR`] if a run ended in error, else success.
+fn exit_for_runs(any_error: bool) -> ExitCode {
+    match crate::interrupt::requested() {
+        Some(signal) => ExitCode::from(crate::interrupt::exit_code(signal)),
+        None if any_error => ExitCode::from(EXIT_RUN_ERROR),
+        None => ExitCode::SUCCESS,
+    }
 }
 
 /// Exit code for a list of pass/fail verdicts: success only when all pass.

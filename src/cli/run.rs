@@ -5,7 +5,7 @@ use crate::run::execute::run_on_twin;
 use crate::run::scenario::PickPlaceScenario;
 use crate::run::summary::render_text;
 use crate::scenario::Override;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `tendril run`.
@@ -42,7 +42,7 @@ impl RunArgs {
         let mut o = self.set.clone();
         o.extend(self.devices.overrides());
         if let Some(seed) = self.seed {
-            o.push(Override { key: "seed".into(), value: toml::Value::Integer(seed as i64) });
+            o.push(Override { key: "seed".into(), value: crate::scenario::seed::to_toml(seed) });
         }
         if let Some(f) = &self.feedback {
             o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
@@ -54,10 +54,11 @@ impl RunArgs {
 
 pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.overrides())?;
-    let dir = a.out.clone().unwrap_or_else(|| Path::new("out").join(&scenario.name));
+    let dir = a.out.clone().unwrap_or_else(|| crate::run::output::default_run_dir(&scenario.name));
+    // Ctrl-C, SIGTERM and SIGHUP: the safe stop, the trace whole and summary.json written.
+    crate::interrupt::install()?;
     let (summary, _) = if a.hardware == "real" {
-        let mut config = a.devices.config(&scenario)?;
-        config.handle_ctrl_c = true;
+        let config = a.devices.config(&scenario)?;
         // This thread runs the ticks; the cell's IO threads, started from it, inherit its priority.
         a.devices.realtime()?.apply_to_current_thread()?;
         crate::run::real::run_on_real(&scenario, config, Some(&dir))?
@@ -66,5 +67,5 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     };
     emit(&render_text(&summary));
     emit(&format!("wrote {0}/trace.csv, {0}/summary.json and {0}/scenario.toml\n", dir.display()));
-    Ok(if summary.outcome == "error" { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+    Ok(super::exit_for_runs(summary.outcome == "error"))
 }

@@ -21,8 +21,8 @@ pub struct ServeArgs {
     /// devices' 30004, 30002, 51971, 51972.
     #[arg(long, value_parser = super::devices::port_base)]
     port_base: Option<u16>,
-    /// Stop after this many seconds (default: until Ctrl-C).
-    #[arg(long)]
+    /// Stop after this many seconds, up to a week (default: until Ctrl-C, SIGTERM or SIGHUP).
+    #[arg(long, value_parser = super::seconds_arg)]
     seconds: Option<f64>,
     /// Override a scenario value: `--set key.path=value` (repeatable).
     #[arg(long = "set")]
@@ -51,19 +51,10 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
         h.twine_id,
         h.dxl_baud
     ));
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
-        std::thread::spawn(move || {
-            rt.block_on(async {
-                let _ = tokio::signal::ctrl_c().await;
-            });
-            stop.store(true, std::sync::atomic::Ordering::SeqCst);
-        });
-    }
+    // Ctrl-C, SIGTERM and SIGHUP alike: the devices are shut down and the status reported.
+    crate::interrupt::install()?;
     let started = std::time::Instant::now();
-    while !stop.load(std::sync::atomic::Ordering::SeqCst) && handle.running() {
+    while crate::interrupt::requested().is_none() && handle.running() {
         if a.seconds.is_some_and(|s| started.elapsed().as_secs_f64() >= s) {
             break;
         }

@@ -14,8 +14,8 @@ pub struct SweepArgs {
     /// Output folder [default: out/<sweep file name>].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Worker threads [default: all cores].
-    #[arg(long)]
+    /// Worker threads [default: all cores], 1 to 1024.
+    #[arg(long, value_parser = threads)]
     threads: Option<usize>,
     /// Run only slice K of N (`--shard 2/8`), for a cluster's job array.
     #[arg(long)]
@@ -23,6 +23,24 @@ pub struct SweepArgs {
     /// Skip the runs already in the results file and append the rest.
     #[arg(long)]
     resume: bool,
+}
+
+/// Most worker threads a sweep may ask for. Why: runs are CPU-bound and each holds its own
+/// simulation state, so threads beyond the cores only cost memory; 1024 is above the hardware
+/// threads of any single machine this runs on (`--threads 100000` once created 10 000 threads).
+pub const MAX_THREADS: usize = 1024;
+
+/// `--threads N` with 1 <= N <= [`MAX_THREADS`].
+fn threads(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(format!("must be a whole number from 1 to {MAX_THREADS}, got {s}")),
+    }
+}
+
+/// `--threads N` with 0 (all cores) or 1 <= N <= [`MAX_THREADS`], for `chart`.
+pub(super) fn threads_or_all(s: &str) -> Result<usize, String> {
+    if s.trim() == "0" { Ok(0) } else { threads(s) }
 }
 
 /// Arguments of `tendril merge`.
@@ -45,7 +63,15 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         shard: a.shard,
         resume: a.resume,
     };
+    // Ctrl-C, SIGTERM and SIGHUP: no new run starts; every finished row is kept whole.
+    crate::interrupt::install()?;
     let stats = run_sweep(&sweep, &options)?;
+    if let Some(bytes) = stats.dropped_tail {
+        emit(&format!("{}: cut off a torn last row ({bytes} bytes); its run is run again\n", stats.results.display()));
+    }
+    if let Some(signal) = crate::interrupt::requested() {
+        emit(&format!("stopped by {}: {} runs finished and written\n", crate::interrupt::name(signal), stats.ran));
+    }
     emit(&format!(
         "{} runs in this sweep{}: {} run now ({} errors), {} already done; {:.0} simulated s in {:.1} s wall ({:.0}x real time)\nwrote {}\n",
         stats.planned,
@@ -58,7 +84,7 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         stats.sim_time_s / stats.wall_time_s.max(1e-9),
         stats.results.display()
     ));
-    Ok(ExitCode::SUCCESS)
+    Ok(super::exit_for_runs(stats.errors > 0))
 }
 
 pub fn merge(a: MergeArgs) -> anyhow::Result<ExitCode> {

@@ -61,7 +61,8 @@ impl Validate for ForceCalibration {
         at.positive("b_pm_per_n", self.b_pm_per_n);
         at.finite("c_pm", self.c_pm);
         at.positive("r", self.r);
-        at.positive("range_n", self.range_n);
+        // 100 N: twenty times the paper's 4.69 N; a soft 12 × 12 mm pad tears long before.
+        at.in_range("range_n", self.range_n, 1e-3, 100.0);
         if let Some(h) = &self.hysteresis {
             at.section("hysteresis", h);
         }

@@ -34,13 +34,20 @@ impl Default for PidConfig {
     }
 }
 
+/// Largest PID gain accepted, in the gains' own units (see [`PidConfig`]); why in `validate`.
+pub const MAX_GAIN: f64 = 1e4;
+
 impl Validate for PidConfig {
     fn validate(&self, at: &mut Checker) {
-        at.non_negative("kp", self.kp);
-        at.non_negative("ki", self.ki);
-        at.non_negative("kd", self.kd);
-        at.positive("max_speed_deg_s", self.max_speed_deg_s);
-        at.positive("derivative_filter_s", self.derivative_filter_s);
+        // At kp = 1e4 (°/s)/N the sensor's noise-limited resolution (2.57 mN, paper Sec. IV-B)
+        // alone commands 26 °/s: beyond it the loop only amplifies noise into the output limit.
+        // The same bound holds for ki and kd (the swept gains reach 80 and 5).
+        for (name, gain) in [("kp", self.kp), ("ki", self.ki), ("kd", self.kd)] {
+            at.in_range(name, gain, 0.0, MAX_GAIN);
+        }
+        at.in_range("max_speed_deg_s", self.max_speed_deg_s, 1e-3, crate::control::task::MX106_MAX_SPEED_DEG_S);
+        // 60 s: slower than the whole closed loop (time constant ≈ 2 s), so no filter at all.
+        at.in_range("derivative_filter_s", self.derivative_filter_s, 1e-6, 60.0);
     }
 }
 

@@ -31,8 +31,13 @@ impl Default for SlipConfig {
 impl Validate for SlipConfig {
     fn validate(&self, at: &mut Checker) {
         at.in_range("slip_fraction", self.slip_fraction, 0.0, 1.0);
-        at.positive("lost_force_n", self.lost_force_n);
-        at.non_negative("lost_hold_s", self.lost_hold_s);
+        // Within the sensor's range (4.69 N, paper Sec. IV-B): a larger threshold is always met.
+        at.require("lost_force_n", self.lost_force_n > 0.0 && self.lost_force_n <= 4.69, || {
+            format!("must be > 0 and at most the sensor's range 4.69 N, got {}", self.lost_force_n)
+        });
+        // 60 s: longer than any phase in which the object is held in the paper (the 15 s grasp,
+        // the 11 s lift), so a longer hold could never declare a loss.
+        at.in_range("lost_hold_s", self.lost_hold_s, 0.0, 60.0);
     }
 }
 

@@ -136,6 +136,14 @@ impl Default for TaskConfig {
     }
 }
 
+/// Longest any one phase of the task may last \[s\]: ten minutes. The paper's longest is the 15 s
+/// grasp; a phase of hours only fills the disk with trace rows (100 Hz × 600 s is 60 000 rows,
+/// about 9 MB) and keeps a sweep's worker busy for nothing.
+pub const MAX_PHASE_S: f64 = 600.0;
+
+/// Fastest the MX-106 turns a motor [°/s]: 45 rpm no-load at 12 V (ROBOTIS datasheet).
+pub const MX106_MAX_SPEED_DEG_S: f64 = 270.0;
+
 impl Validate for TaskConfig {
     fn validate(&self, at: &mut Checker) {
         for (name, pose) in [
@@ -149,18 +157,42 @@ impl Validate for TaskConfig {
                 format!("every joint angle must lie within ±360°, got {pose:?}")
             });
         }
-        at.non_negative("settle_s", self.settle_s);
+        at.in_range("settle_s", self.settle_s, 0.0, MAX_PHASE_S);
         at.in_range("growth_m", self.growth_m, 0.0, 0.3);
-        at.positive("growth_speed_m_s", self.growth_speed_m_s);
-        at.positive("wrap_speed_deg_s", self.wrap_speed_deg_s);
+        // 1 m/s: faster than any servo and pinion feeds a soft strip (the default is 5 cm/s);
+        // the growth must also finish within a phase.
+        at.in_range("growth_speed_m_s", self.growth_speed_m_s, 1e-6, 1.0);
+        at.require("growth_speed_m_s", self.growth_m / self.growth_speed_m_s <= MAX_PHASE_S, || {
+            format!(
+                "growing {} m at {} m/s would take longer than {MAX_PHASE_S} s",
+                self.growth_m, self.growth_speed_m_s
+            )
+        });
+        at.in_range("wrap_speed_deg_s", self.wrap_speed_deg_s, 1e-3, MX106_MAX_SPEED_DEG_S);
         at.positive("wrap_contact_n", self.wrap_contact_n);
-        at.positive("wrap_timeout_s", self.wrap_timeout_s);
-        at.non_negative("grasp_s", self.grasp_s);
-        at.non_negative("lift_s", self.lift_s);
-        at.non_negative("transfer_s", self.transfer_s);
-        at.non_negative("lower_s", self.lower_s);
-        at.non_negative("release_s", self.release_s);
+        at.in_range("wrap_timeout_s", self.wrap_timeout_s, 1e-3, MAX_PHASE_S);
+        for (name, value) in [
+            ("grasp_s", self.grasp_s),
+            ("lift_s", self.lift_s),
+            ("transfer_s", self.transfer_s),
+            ("lower_s", self.lower_s),
+            ("release_s", self.release_s),
+        ] {
+            at.in_range(name, value, 0.0, MAX_PHASE_S);
+        }
         at.section("limits", &self.limits);
+        // Slow joint limits stretch the moves: each must still fit in a phase.
+        let moves = [
+            (&self.home_deg, &self.lift_deg),
+            (&self.lift_deg, &self.transfer_deg),
+            (&self.transfer_deg, &self.place_deg),
+        ];
+        for (from, to) in moves {
+            let duration_s = JointMove::plan(radians(from), radians(to), &self.limits, 0.0).duration_s();
+            at.require("limits", duration_s.is_nan() || duration_s <= MAX_PHASE_S, || {
+                format!("an arm move within these limits takes {duration_s:.0} s, longer than {MAX_PHASE_S} s")
+            });
+        }
     }
 }
 

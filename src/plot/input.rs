@@ -3,6 +3,11 @@
 use super::PlotError;
 use std::path::Path;
 
+/// Largest magnitude [`Row::plotted`] accepts. Why: the trace's quantities (forces in N, motor
+/// speeds in °/s) stay within a few hundred; a value of 1e308 is a fault, and drawn it would squash
+/// every other value onto one line of the axis.
+pub const MAX_PLOTTED: f64 = 1e6;
+
 /// A CSV file read whole: its header and its rows with their line numbers.
 #[derive(Debug, Clone)]
 pub struct Table {
@@ -102,6 +107,20 @@ impl Row<'_> {
         t.parse::<f64>()
             .map(Some)
             .map_err(|_| self.error(format!("column `{}`: `{t}` is not a number", self.table.header[col])))
+    }
+
+    /// A number to draw: NaN (a gap, as ground truth without a model) or finite within
+    /// ±[`MAX_PLOTTED`]; infinities and larger values are errors naming the line and column.
+    pub fn plotted(&self, col: usize) -> Result<f64, PlotError> {
+        let v = self.f64(col)?;
+        if v.is_nan() || v.abs() <= MAX_PLOTTED {
+            Ok(v)
+        } else {
+            Err(self.error(format!(
+                "column `{}`: {v:e} is beyond ±{MAX_PLOTTED:e}: not a value to draw",
+                self.table.header[col]
+            )))
+        }
     }
 
     /// A finite, strictly positive number (an axis on a log scale).

@@ -98,12 +98,12 @@ pub fn read(run_dir: &Path) -> Result<RunTrace, PlotError> {
         let p = TracePoint {
             time_s: r.f64(time)?,
             phase: r.one_of(phase, &PHASES)?,
-            true_force_n: r.f64(truth)?,
-            force_n: r.f64(force)?,
-            force_uncompensated_n: r.f64(unc)?,
-            setpoint_n: r.f64(setpoint)?,
+            true_force_n: r.plotted(truth)?,
+            force_n: r.plotted(force)?,
+            force_uncompensated_n: r.plotted(unc)?,
+            setpoint_n: r.plotted(setpoint)?,
             controller_on: r.bool(on)?,
-            controller_output_deg_s: r.f64(out)?,
+            controller_output_deg_s: r.plotted(out)?,
         };
         if !p.time_s.is_finite() || points.last().is_some_and(|q: &TracePoint| q.time_s > p.time_s) {
             return Err(r.error(format!("time_s {} is not finite or goes backwards", p.time_s)));
@@ -112,6 +112,20 @@ pub fn read(run_dir: &Path) -> Result<RunTrace, PlotError> {
     }
     if points.len() < 2 {
         return Err(t.empty("fewer than two rows: nothing to draw"));
+    }
+    // The estimate, the setpoint and the controller's output are always there; only the ground
+    // truth may be all NaN (a real cell has none). A column without a single number is refused.
+    type Column = (&'static str, fn(&TracePoint) -> f64);
+    let columns: [Column; 4] = [
+        ("force_n", |p| p.force_n),
+        ("force_uncompensated_n", |p| p.force_uncompensated_n),
+        ("setpoint_n", |p| p.setpoint_n),
+        ("controller_output_deg_s", |p| p.controller_output_deg_s),
+    ];
+    for (name, value) in columns {
+        if !points.iter().any(|p| value(p).is_finite()) {
+            return Err(t.empty(&format!("column `{name}` has no finite value: nothing to draw")));
+        }
     }
     let summary_path = run_dir.join("summary.json");
     let summary = if summary_path.is_file() {

@@ -40,6 +40,8 @@ pub fn run_on_twin(
     out: Option<&Path>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     let started = std::time::Instant::now();
+    // Warnings left on this thread by an earlier run are not this run's.
+    let _ = crate::mujoco_log::take_warnings();
     let mut cell = SimCell::for_scenario(scenario, models.get(&scenario.scene_spec())?);
     run_on_cell(&mut cell, scenario, out, started)
 }
@@ -62,9 +64,22 @@ pub fn run_on_cell(
         None => None,
     };
     let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
-    let summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
+    let mut summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
+    // The run's own thread stepped its physics (and compiled its model, if not cached).
+    summary.warnings = crate::mujoco_log::take_warnings();
     if let Some(dir) = out {
-        write_summary(dir, &summary, scenario)?;
+        // Every file is attempted, and every failure is reported: a trace that could not be
+        // written is an error even when summary.json could be.
+        let mut failures = Vec::new();
+        if let Some(e) = trace.as_ref().and_then(TraceWriter::error) {
+            failures.push(format!("{}: cannot write: {e}", dir.join("trace.csv").display()));
+        }
+        if let Err(e) = write_summary(dir, &summary, scenario) {
+            failures.push(format!("{e:#}"));
+        }
+        if !failures.is_empty() {
+            anyhow::bail!("{}", failures.join("; "));
+        }
     }
     Ok((summary, report))
 }
@@ -78,16 +93,18 @@ pub fn write_summary(dir: &Path, summary: &RunSummary, scenario: &PickPlaceScena
     if let serde_json::Value::Object(fields) = &mut record {
         fields.insert("effective_scenario".into(), serde_json::to_value(scenario)?);
     }
-    let path = dir.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&record)? + "\n")
-        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+    // Atomically: a failed write (a full disk) keeps the previous file whole.
+    let write = |path: &Path, text: &str| {
+        super::output::write_atomically(path, text.as_bytes())
+            .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
+    };
+    write(&dir.join("summary.json"), &(serde_json::to_string_pretty(&record)? + "\n"))?;
     let path = dir.join("scenario.toml");
     let text = toml::to_string(scenario).map_err(|e| anyhow::anyhow!("{}: cannot encode: {e}", path.display()))?;
-    std::fs::write(
+    write(
         &path,
-        format!(
+        &format!(
             "# The effective scenario of this run (defaults, file and --set applied): `tendril run` repeats it.\n{text}"
         ),
     )
-    .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
 }

@@ -5,12 +5,14 @@
 //! - [`runner`]: the control loop over any [`crate::hardware::Cell`].
 //! - [`scenario`]: the pick-and-place scenario file.
 //! - [`trace`]: `trace.csv`, one row per tick.
+//! - [`output`]: the default output folder derived from a scenario's name.
 //! - [`metrics`]: rise time, overshoot, fluctuation, estimate error.
 //! - [`summary`]: the `summary.json` record.
 
 pub mod drop_watch;
 pub mod execute;
 pub mod metrics;
+pub mod output;
 pub mod real;
 pub mod runner;
 pub mod scenario;

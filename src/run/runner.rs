@@ -96,6 +96,11 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
         let mut tare = TareAverager::default();
         let mut unloaded_n = 0.0;
         for tick in 0u64.. {
+            // An operator stop (Ctrl-C, SIGTERM, SIGHUP) ends the run like a device fault: through
+            // the cell's safe stop below, with every row written whole.
+            if let Some(signal) = crate::interrupt::requested() {
+                return Err(CellError::Stopped { signal: crate::interrupt::name(signal), time_s: tick as f64 * dt });
+            }
             let state = cell.read()?;
             if sequencer.phase() == Phase::Home {
                 // Tare on the mean of the samples at home, finger retracted and untouched.
@@ -151,6 +156,7 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
     let result = run();
     let stop = cell.deactivate();
     if let Some(w) = trace {
+        // A failed flush is kept in the writer and reported by the caller with the other write errors.
         let _ = w.flush();
     }
     let error = result.err().or(stop.err()).map(|e| e.to_string());

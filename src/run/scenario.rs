@@ -28,8 +28,13 @@ use serde::{Deserialize, Serialize};
 pub struct PickPlaceScenario {
     /// Scenario name, echoed in summaries.
     pub name: String,
-    /// Seed of every random process (sensor noise) [-]; the same seed gives the same trace.
-    #[serde(default = "default_seed")]
+    /// Seed of every random process (sensor noise) [-]; the same seed gives the same trace. Any
+    /// `u64` (above `i64::MAX` as a decimal string, see [`crate::scenario::seed`]).
+    #[serde(
+        default = "default_seed",
+        deserialize_with = "crate::scenario::seed::deserialize",
+        serialize_with = "crate::scenario::seed::serialize"
+    )]
     pub seed: u64,
     /// Contact-force setpoint \[N\] (paper Sec. V-B: crimper 0.6, hammer 1.6, shampoo 0.8).
     pub setpoint_n: f64,
@@ -91,14 +96,9 @@ fn default_rate() -> f64 {
 impl Validate for PickPlaceScenario {
     fn validate(&self, at: &mut Checker) {
         at.require("name", !self.name.trim().is_empty(), || "must not be empty".into());
-        // Above the sensor's range the reading saturates (4.69 N, paper Sec. IV-B).
-        at.require("setpoint_n", self.setpoint_n > 0.0 && self.setpoint_n < self.estimator.range_n, || {
-            format!("must be > 0 and below the sensor's range {} N, got {}", self.estimator.range_n, self.setpoint_n)
-        });
         at.in_range("control_rate_hz", self.control_rate_hz, 1.0, 1000.0);
-        at.require("control_rate_hz", self.control_rate_hz <= self.interrogator.sample_rate_hz, || {
-            format!("must not exceed interrogator.sample_rate_hz ({})", self.interrogator.sample_rate_hz)
-        });
+        // The sections first: a cross-check below that reads a bad value (estimator.range_n = nan)
+        // must not be reported on the key that reads it (setpoint_n).
         at.section("object", &self.object);
         at.section("controller", &self.controller);
         at.section("task", &self.task);
@@ -111,6 +111,17 @@ impl Validate for PickPlaceScenario {
         at.section("physics", &self.physics);
         at.section("finger", &self.finger);
         at.section("hardware", &self.hardware);
+        // Above the sensor's range the reading saturates (4.69 N, paper Sec. IV-B).
+        at.require("setpoint_n", self.setpoint_n > 0.0 && self.setpoint_n < self.estimator.range_n, || {
+            format!("must be > 0 and below the sensor's range {} N, got {}", self.estimator.range_n, self.setpoint_n)
+        });
+        at.require("control_rate_hz", self.control_rate_hz <= self.interrogator.sample_rate_hz, || {
+            format!("must not exceed interrogator.sample_rate_hz ({})", self.interrogator.sample_rate_hz)
+        });
+        // First contact must be felt below the top of the range, or the close never ends.
+        at.require("task.wrap_contact_n", self.task.wrap_contact_n < self.estimator.range_n, || {
+            format!("must be below the sensor's range {} N, got {}", self.estimator.range_n, self.task.wrap_contact_n)
+        });
         let tendon_max_m = self.gripper.tendon_pull_m(self.gripper.twine_max_deg.to_radians());
         at.require("gripper.twine_max_deg", tendon_max_m <= self.finger.twine_max_m + 1e-9, || {
             format!(

@@ -65,6 +65,10 @@ pub struct RunSummary {
     pub real_time_factor: f64,
     /// The error that ended the run, with its time.
     pub error: Option<String>,
+    /// MuJoCo's warnings during the run (see [`crate::mujoco_log`]), at most
+    /// [`crate::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl RunSummary {
@@ -104,6 +108,7 @@ impl RunSummary {
             wall_time_s,
             real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },
             error: report.error.clone(),
+            warnings: Vec::new(),
         }
     }
 }

@@ -5,10 +5,13 @@
 //! deserialised with unknown keys rejected, and the result is checked with [`Validate`]. Any
 //! failure is a [`ScenarioError`] that names the file, the dotted key and the reason.
 
+mod magnitude;
 mod overrides;
 mod paths;
+pub mod seed;
 mod validate;
 
+pub use magnitude::{MAX_MAGNITUDE, check_magnitudes};
 pub use overrides::{Override, apply_overrides};
 pub use validate::{Checker, Validate};
 
@@ -25,6 +28,16 @@ pub enum ScenarioError {
         file: PathBuf,
         /// The underlying IO error.
         source: std::io::Error,
+    },
+    /// The file is not UTF-8 text (TOML must be).
+    #[error("{file}: line {line}, column {column}: not UTF-8 text (a TOML file must be UTF-8)")]
+    Encoding {
+        /// The scenario file.
+        file: PathBuf,
+        /// 1-based line of the first invalid byte.
+        line: usize,
+        /// 1-based byte column of the first invalid byte.
+        column: usize,
     },
     /// The file is not valid TOML.
     #[error("{file}: not valid TOML: {message}")]
@@ -56,8 +69,20 @@ pub enum ScenarioError {
 
 /// Reads, overrides, deserialises and validates a scenario of type `T` from `file`.
 pub fn load<T: DeserializeOwned + Validate>(file: &Path, overrides: &[Override]) -> Result<T, ScenarioError> {
-    let text = std::fs::read_to_string(file).map_err(|source| ScenarioError::Io { file: file.into(), source })?;
+    let text = read_text(file)?;
     from_str(&text, file, overrides)
+}
+
+/// Reads `file` as UTF-8 text; invalid bytes are reported with their line and column (std's
+/// `read_to_string` gives no position).
+pub fn read_text(file: &Path) -> Result<String, ScenarioError> {
+    let bytes = std::fs::read(file).map_err(|source| ScenarioError::Io { file: file.into(), source })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = valid.len() - valid.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1) + 1;
+        ScenarioError::Encoding { file: file.into(), line, column }
+    })
 }
 
 /// As [`load`], from text already in memory; `file` is only used in messages.
@@ -75,6 +100,9 @@ pub fn from_str<T: DeserializeOwned + Validate>(
 
 /// Deserialises and validates an already-parsed table (sweeps build these directly).
 pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: &Path) -> Result<T, ScenarioError> {
+    if let Some((key, reason)) = check_magnitudes(&table) {
+        return Err(ScenarioError::Invalid { file: file.into(), key, reason });
+    }
     paths::resolve_object(&mut table, file);
     paths::resolve_models(&mut table, file);
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {

@@ -9,7 +9,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BenchScenario {
-    /// Seed of every random draw (interrogator and load-cell noise) [-].
+    /// Seed of every random draw (interrogator and load-cell noise) [-]; any `u64` (above
+    /// `i64::MAX` as a decimal string, see [`crate::scenario::seed`]).
+    #[serde(
+        deserialize_with = "crate::scenario::seed::deserialize",
+        serialize_with = "crate::scenario::seed::serialize"
+    )]
     pub seed: u64,
     /// The sensor (defaults: the paper's).
     #[serde(default)]
@@ -41,6 +46,11 @@ impl BenchScenario {
             + self.taped_heating.is_some() as usize
     }
 }
+
+/// Longest stage of a bench experiment \[s\]: a day. The paper's longest is the water bath's
+/// holds of minutes; the simulated bench draws every interrogator sample, so a stage of 1e9 s would
+/// run for days.
+pub const MAX_STAGE_S: f64 = 86_400.0;
 
 impl Validate for BenchScenario {
     fn validate(&self, at: &mut Checker) {
@@ -126,7 +136,8 @@ impl Default for RecorderConfig {
 
 impl Validate for RecorderConfig {
     fn validate(&self, at: &mut Checker) {
-        at.positive("rate_hz", self.rate_hz);
+        // Up to the fastest interrogator's 10 kHz: the recorder cannot log faster than it samples.
+        at.in_range("rate_hz", self.rate_hz, 1e-3, 10_000.0);
         at.non_negative("thermometer_resolution_c", self.thermometer_resolution_c);
     }
 }
@@ -152,13 +163,16 @@ pub struct ForceCycles {
 
 impl Validate for ForceCycles {
     fn validate(&self, at: &mut Checker) {
-        at.require("cycles", self.cycles >= 1, || "must be at least 1".into());
+        // 1000 cycles: the paper runs 5; a thousand of the 30 s cycles is over eight hours.
+        at.require("cycles", (1..=1000).contains(&self.cycles), || {
+            format!("must be from 1 to 1000, got {}", self.cycles)
+        });
         at.positive("peak_force_n", self.peak_force_n);
-        at.positive("load_time_s", self.load_time_s);
-        at.positive("unload_time_s", self.unload_time_s);
+        at.in_range("load_time_s", self.load_time_s, 1e-3, MAX_STAGE_S);
+        at.in_range("unload_time_s", self.unload_time_s, 1e-3, MAX_STAGE_S);
         let tare = crate::calibration::TARE_WINDOW_S;
-        at.require("rest_s", self.rest_s.is_finite() && self.rest_s > tare, || {
-            format!("must be > {tare} s (the tare needs an unloaded start), got {}", self.rest_s)
+        at.require("rest_s", self.rest_s.is_finite() && self.rest_s > tare && self.rest_s <= MAX_STAGE_S, || {
+            format!("must be > {tare} s (the tare needs an unloaded start) and <= {MAX_STAGE_S} s, got {}", self.rest_s)
         });
         at.finite("temperature_c", self.temperature_c);
     }
@@ -184,8 +198,8 @@ impl Validate for WaterBath {
         at.require("end_c", self.end_c.is_finite() && self.end_c != self.start_c, || {
             "must be finite and differ from start_c".into()
         });
-        at.require("hold_s", self.hold_s.is_finite() && self.hold_s >= 1.0, || "must be >= 1 s".into());
-        at.positive("ramp_s", self.ramp_s);
+        at.in_range("hold_s", self.hold_s, 1.0, MAX_STAGE_S);
+        at.in_range("ramp_s", self.ramp_s, 1e-3, MAX_STAGE_S);
     }
 }
 
@@ -224,7 +238,7 @@ pub struct TapedHeating {
 
 impl Validate for TapedHeating {
     fn validate(&self, at: &mut Checker) {
-        at.positive("duration_s", self.duration_s);
+        at.in_range("duration_s", self.duration_s, 1e-3, MAX_STAGE_S);
         at.finite("start_c", self.start_c);
         at.finite("end_c", self.end_c);
         at.non_negative("heating_start_s", self.heating_start_s);

@@ -1,7 +1,8 @@
 //! Running a sweep: check every run first, then run them in parallel, appending each result
 //! to `results.csv` as it finishes.
 
-use super::results::{ResultsWriter, finished_ids, header, row};
+use super::durable::ResultsFile;
+use super::results::{header, row, sweep_id};
 use super::{Shard, Sweep, SweepRun};
 use crate::run::execute::{ModelCache, run_on_twin};
 use crate::run::scenario::PickPlaceScenario;
@@ -40,6 +41,8 @@ pub struct SweepStats {
     pub sim_time_s: f64,
     /// Wall time of the whole sweep \[s\].
     pub wall_time_s: f64,
+    /// Bytes of a torn last row `--resume` cut off the results file (that run was run again).
+    pub dropped_tail: Option<usize>,
 }
 
 /// The results file of a sweep (one per shard, so shards never write the same file).
@@ -52,11 +55,47 @@ pub fn results_path(out_dir: &Path, shard: Option<Shard>) -> PathBuf {
 
 /// Loads every run's scenario with its overrides: the first bad key or value stops the sweep
 /// before anything runs.
+///
+/// A bad value that came from the sweep file (a grid or list value) is reported against the
+/// sweep file, at `grid."key"` or `list[i].key`, with the run and scenario it was found in.
 pub fn check_runs(sweep: &Sweep) -> Result<(), crate::scenario::ScenarioError> {
+    use crate::scenario::ScenarioError;
+    // Each scenario file is read and parsed once; the runs only differ in their overrides.
+    let mut tables: std::collections::HashMap<&Path, toml::Table> = Default::default();
     for run in &sweep.runs {
-        crate::scenario::load::<PickPlaceScenario>(&run.scenario, &run.overrides)?;
+        if !tables.contains_key(run.scenario.as_path()) {
+            let text = crate::scenario::read_text(&run.scenario)?;
+            let table = text.parse().map_err(|e: toml::de::Error| ScenarioError::Syntax {
+                file: run.scenario.clone(),
+                message: e.to_string(),
+            })?;
+            tables.insert(&run.scenario, table);
+        }
+        let mut table = tables[run.scenario.as_path()].clone();
+        let loaded = crate::scenario::apply_overrides(&mut table, &run.overrides)
+            .and_then(|()| crate::scenario::from_table::<PickPlaceScenario>(table, &run.scenario));
+        match loaded {
+            Ok(_) => {}
+            Err(ScenarioError::Invalid { key, reason, .. }) if run.overrides.iter().any(|o| o.key == key) => {
+                let place = match run.list_index.filter(|_| list_sets(sweep, run, &key)) {
+                    Some(i) => format!("list[{i}].{key}"),
+                    None => format!("grid.\"{key}\""),
+                };
+                return Err(ScenarioError::Invalid {
+                    file: sweep.file.clone(),
+                    key: place,
+                    reason: format!("{reason} (run {} on {})", run.id, run.scenario.display()),
+                });
+            }
+            Err(e) => return Err(e),
+        }
     }
     Ok(())
+}
+
+/// Whether `run`'s list entry sets `key` (list values override grid values).
+fn list_sets(sweep: &Sweep, run: &SweepRun, key: &str) -> bool {
+    run.list_index.is_some_and(|i| sweep.list_keys.get(i).is_some_and(|keys| keys.iter().any(|k| k == key)))
 }
 
 fn execute_one(run: &SweepRun, models: &ModelCache) -> RunSummary {
@@ -78,17 +117,13 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
     std::fs::create_dir_all(&options.out_dir)
         .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", options.out_dir.display()))?;
     let results = results_path(&options.out_dir, options.shard);
-    let done = if options.resume { finished_ids(&results)? } else { Default::default() };
-    if !options.resume && results.exists() {
-        anyhow::bail!("{} exists: pass --resume to continue it, or choose another --out", results.display());
-    }
+    let id = sweep_id(sweep);
+    let (file, opened) =
+        ResultsFile::open(&results, sweep, &id, &header(sweep, &RunSummary::columns()), options.resume, options.shard)?;
+    let done = opened.done;
     let mine: Vec<&SweepRun> = sweep.runs.iter().filter(|r| options.shard.is_none_or(|s| s.owns(r.id))).collect();
     let todo: Vec<&SweepRun> = mine.iter().copied().filter(|r| !done.contains(&r.id)).collect();
-
-    let writer = Mutex::new(
-        ResultsWriter::open(&results, &header(sweep, &RunSummary::columns()))
-            .map_err(|e| anyhow::anyhow!("{}: {e}", results.display()))?,
-    );
+    let writer = Mutex::new(file);
     let progress = indicatif::ProgressBar::new(todo.len() as u64);
     progress.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {per_sec}  ETA {eta}")
@@ -96,18 +131,26 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
     );
     let models = ModelCache::default();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(options.threads.unwrap_or(0)).build()?;
-    let outcomes: Vec<anyhow::Result<(bool, f64)>> = pool.install(|| {
+    // After a write error (a full disk) no further run starts: its row could not be kept.
+    let write_failed = std::sync::atomic::AtomicBool::new(false);
+    let outcomes: Vec<anyhow::Result<Option<(bool, f64)>>> = pool.install(|| {
         todo.par_iter()
             .map(|run| {
+                if crate::interrupt::requested().is_some() || write_failed.load(std::sync::atomic::Ordering::SeqCst) {
+                    return Ok(None);
+                }
                 let summary = execute_one(run, &models);
-                let cells = row(sweep, run, &summary);
-                writer
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .append(&cells)
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", results.display()))?;
+                // A run cut short by an operator stop is not done: no row, so --resume runs it.
+                if crate::interrupt::requested().is_some() {
+                    return Ok(None);
+                }
+                let cells = row(sweep, &id, run, &summary);
+                if let Err(e) = writer.lock().unwrap_or_else(|p| p.into_inner()).append(&cells) {
+                    write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
+                    return Err(e.into());
+                }
                 progress.inc(1);
-                Ok((summary.outcome == "error", summary.sim_time_s))
+                Ok(Some((summary.outcome == "error", summary.sim_time_s)))
             })
             .collect()
     });
@@ -120,9 +163,10 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
         errors: 0,
         sim_time_s: 0.0,
         wall_time_s: 0.0,
+        dropped_tail: opened.dropped_tail,
     };
     for o in outcomes {
-        let (error, sim) = o?;
+        let Some((error, sim)) = o? else { continue };
         stats.ran += 1;
         stats.errors += usize::from(error);
         stats.sim_time_s += sim;

@@ -1,9 +1,11 @@
 //! `tendril sweep`: many runs over a grid of scenario keys, in parallel, resumable, shardable.
 //!
 //! - [`spec`]: the sweep file and its expansion into runs.
-//! - [`results`]: the incremental `results.csv`, resume and shard merging.
+//! - [`results`]: the incremental `results.csv`, its rows and shard merging.
+//! - [`durable`]: checking, repairing and locking a results file before a resume appends.
 //! - [`execute`]: checking and running the runs in parallel.
 
+pub mod durable;
 pub mod execute;
 pub mod results;
 pub mod spec;

@@ -1,9 +1,9 @@
 //! `results.csv`: one row per finished run, appended as runs finish so that a killed sweep
 //! keeps everything it finished; read back for `--resume` and merged across shards.
 
+use super::durable::ResultsError;
 use super::spec::{Sweep, SweepRun};
 use crate::run::summary::RunSummary;
-use std::collections::BTreeSet;
 use std::path::Path;
 
 /// The summary's fields as flat (column, value) pairs; nested objects become dotted columns.
@@ -18,6 +18,15 @@ pub fn flatten_summary(summary: &RunSummary) -> Vec<(String, String)> {
             }
             serde_json::Value::Null => out.push((prefix.to_string(), String::new())),
             serde_json::Value::String(s) => out.push((prefix.to_string(), s.clone())),
+            // A list of messages (the MuJoCo warnings) is one cell.
+            serde_json::Value::Array(items) => out.push((
+                prefix.to_string(),
+                items
+                    .iter()
+                    .map(|v| v.as_str().map_or_else(|| v.to_string(), str::to_string))
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            )),
             other => out.push((prefix.to_string(), other.to_string())),
         }
     }
@@ -34,124 +43,120 @@ fn value_text(v: &toml::Value) -> String {
     }
 }
 
+/// Name of the column that holds [`sweep_id`] on every row.
+pub const SWEEP_ID_COLUMN: &str = "sweep_id";
+
+/// Columns at the start of every row that identify its run: `run_id`, `sweep_id`, `scenario_file`,
+/// then the swept keys (see [`header`]).
+pub fn identity_columns(sweep: &Sweep) -> usize {
+    3 + sweep.keys.len()
+}
+
+/// The sweep's identity: 16 hex digits of a 64-bit FNV-1a hash of its expanded run list (each
+/// run's id, scenario file name and overrides). Every row carries it, so `--resume` and `merge`
+/// refuse rows from another sweep whose columns happen to match. Scenario files are named by
+/// file name only, so resuming from another working directory is the same sweep.
+pub fn sweep_id(sweep: &Sweep) -> String {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut feed = |bytes: &[u8]| {
+        for b in bytes.iter().chain([&0u8]) {
+            hash ^= u64::from(*b);
+            hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    for run in &sweep.runs {
+        feed(run.id.to_string().as_bytes());
+        feed(scenario_name(&run.scenario).as_bytes());
+        for o in &run.overrides {
+            feed(o.key.as_bytes());
+            feed(o.value.to_string().as_bytes());
+        }
+    }
+    format!("{hash:016x}")
+}
+
+/// A scenario file as compared between rows: its file name.
+pub fn scenario_name(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().to_string())
+}
+
 /// The header of a sweep's results file.
 pub fn header(sweep: &Sweep, summary_columns: &[String]) -> Vec<String> {
-    let mut h = vec!["run_id".to_string(), "scenario_file".to_string()];
+    let mut h = vec!["run_id".to_string(), SWEEP_ID_COLUMN.to_string(), "scenario_file".to_string()];
     h.extend(sweep.keys.iter().cloned());
     h.extend(summary_columns.iter().cloned());
     h
 }
 
-/// One results row for `run`.
-pub fn row(sweep: &Sweep, run: &SweepRun, summary: &RunSummary) -> Vec<String> {
-    let mut r = vec![run.id.to_string(), run.scenario.display().to_string()];
+/// The identity cells of `run`'s row (the first [`identity_columns`]).
+pub fn identity_cells(sweep: &Sweep, id: &str, run: &SweepRun) -> Vec<String> {
+    let mut r = vec![run.id.to_string(), id.to_string(), run.scenario.display().to_string()];
     for key in &sweep.keys {
         r.push(run.overrides.iter().find(|o| &o.key == key).map(|o| value_text(&o.value)).unwrap_or_default());
     }
+    r.into_iter().map(one_line).collect()
+}
+
+/// A cell on one line: line breaks become spaces (see [`row`]).
+fn one_line(cell: String) -> String {
+    if cell.contains(['\n', '\r']) { cell.replace(['\n', '\r'], " ") } else { cell }
+}
+
+/// One results row for `run` of the sweep whose [`sweep_id`] is `id`. Line breaks inside cells
+/// (an error message's) become spaces, so every row is exactly one line: a torn row is then
+/// always recognisable as a last line without its newline.
+pub fn row(sweep: &Sweep, id: &str, run: &SweepRun, summary: &RunSummary) -> Vec<String> {
+    let mut r = identity_cells(sweep, id, run);
     r.extend(flatten_summary(summary).into_iter().map(|(_, v)| v));
-    r
-}
-
-/// Appends rows to a results file, writing the header when the file is new, flushing each row.
-pub struct ResultsWriter {
-    out: csv::Writer<std::fs::File>,
-}
-
-impl ResultsWriter {
-    /// Opens `path` for appending; writes `header` if the file is empty.
-    pub fn open(path: &Path, header: &[String]) -> std::io::Result<ResultsWriter> {
-        let file = std::fs::OpenOptions::new().create(true).append(true).open(path)?;
-        let fresh = file.metadata()?.len() == 0;
-        let mut out = csv::WriterBuilder::new().from_writer(file);
-        if fresh {
-            out.write_record(header)?;
-            out.flush()?;
-        }
-        Ok(ResultsWriter { out })
-    }
-
-    /// Appends one row and flushes it to the file.
-    pub fn append(&mut self, row: &[String]) -> std::io::Result<()> {
-        self.out.write_record(row)?;
-        self.out.flush()
-    }
-}
-
-/// The run ids already in a results file (none if it does not exist).
-pub fn finished_ids(path: &Path) -> Result<BTreeSet<usize>, csv::Error> {
-    if !path.exists() {
-        return Ok(BTreeSet::new());
-    }
-    let mut reader = csv::Reader::from_path(path)?;
-    let mut ids = BTreeSet::new();
-    for record in reader.records() {
-        // A row cut short by a kill is skipped: its run is simply done again.
-        if let Ok(record) = record
-            && let Some(id) = record.get(0).and_then(|s| s.parse().ok())
-        {
-            ids.insert(id);
-        }
-    }
-    Ok(ids)
-}
-
-/// Why shard files could not be merged.
-#[derive(Debug, thiserror::Error)]
-pub enum MergeError {
-    /// A file could not be read or written.
-    #[error("{file}: {source}")]
-    Csv {
-        /// The file.
-        file: String,
-        /// The CSV or IO error.
-        source: csv::Error,
-    },
-    /// Two files have different columns, so they come from different sweeps.
-    #[error("{file}: its columns differ from {first}'s; shards of one sweep share a header")]
-    HeaderMismatch {
-        /// The odd file.
-        file: String,
-        /// The first file.
-        first: String,
-    },
+    r.into_iter().map(one_line).collect()
 }
 
 /// Merges shard files into `out`: one header, rows sorted by run id, duplicates dropped.
-/// Returns the number of rows written.
-pub fn merge(inputs: &[&Path], out: &Path) -> Result<usize, MergeError> {
-    let csv_err = |file: &Path| {
-        let file = file.display().to_string();
-        move |source| MergeError::Csv { file: file.clone(), source }
-    };
-    let mut header: Option<csv::StringRecord> = None;
-    let mut rows: std::collections::BTreeMap<usize, csv::StringRecord> = Default::default();
+/// Every input is checked as `--resume` checks it ([`super::durable::scan`]): a torn header or last
+/// line, a row that is not whole, or rows of another sweep (another `sweep_id`) refuse the merge.
+/// The merged file is written beside `out` and renamed over it, so a failed merge leaves no
+/// half-written `out`. Returns the number of rows written.
+pub fn merge(inputs: &[&Path], out: &Path) -> Result<usize, ResultsError> {
+    let mut header: Option<(String, &Path)> = None;
+    let mut sweep: Option<(String, &Path)> = None;
+    let mut rows: std::collections::BTreeMap<usize, String> = Default::default();
     for input in inputs {
-        let mut reader = csv::Reader::from_path(input).map_err(csv_err(input))?;
-        let h = reader.headers().map_err(csv_err(input))?.clone();
+        let bytes = super::durable::read_regular(input)?;
+        let scan = super::durable::scan(&bytes, input)?;
+        if let Some(torn) = scan.torn_tail {
+            return Err(ResultsError::TornLastLine { file: input.to_path_buf(), bytes: torn.len });
+        }
         match &header {
-            None => header = Some(h),
-            Some(first) if *first != h => {
-                return Err(MergeError::HeaderMismatch {
-                    file: input.display().to_string(),
-                    first: inputs[0].display().to_string(),
+            None => header = Some((scan.header.clone(), input)),
+            Some((first, first_file)) if *first != scan.header => {
+                return Err(ResultsError::HeaderMismatch {
+                    file: input.to_path_buf(),
+                    first: first_file.to_path_buf(),
                 });
             }
             _ => {}
         }
-        for record in reader.records() {
-            let record = record.map_err(csv_err(input))?;
-            if let Some(id) = record.get(0).and_then(|s| s.parse().ok()) {
-                rows.entry(id).or_insert(record);
+        for r in scan.rows {
+            match &sweep {
+                None => sweep = Some((r.sweep_id.clone(), input)),
+                Some((id, first_file)) if *id != r.sweep_id => {
+                    return Err(ResultsError::ForeignSweep {
+                        file: input.to_path_buf(),
+                        line: r.line,
+                        found: r.sweep_id,
+                        expected: format!("{id} (the sweep of {})", first_file.display()),
+                    });
+                }
+                _ => {}
             }
+            rows.entry(r.run_id).or_insert(r.text);
         }
     }
-    let mut writer = csv::Writer::from_path(out).map_err(csv_err(out))?;
-    if let Some(h) = &header {
-        writer.write_record(h).map_err(csv_err(out))?;
+    let mut text = header.map(|(h, _)| h + "\n").unwrap_or_default();
+    for line in rows.values() {
+        text += line;
+        text.push('\n');
     }
-    for record in rows.values() {
-        writer.write_record(record).map_err(csv_err(out))?;
-    }
-    writer.flush().map_err(|e| MergeError::Csv { file: out.display().to_string(), source: e.into() })?;
+    super::durable::write_atomically(out, text.as_bytes())?;
     Ok(rows.len())
 }

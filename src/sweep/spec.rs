@@ -38,7 +38,15 @@ pub struct SweepRun {
     pub scenario: PathBuf,
     /// Overrides, in key order.
     pub overrides: Vec<Override>,
+    /// Which `[[list]]` entry this run takes its list keys from (`None` without a list), so a
+    /// bad value is reported at its place in the sweep file.
+    pub list_index: Option<usize>,
 }
+
+/// Most runs one sweep may expand to. Why: a run of the 60 s task takes seconds of CPU, so 100 000
+/// runs are already days on a cluster; a grid of 10⁶ runs only sat expanding (and checking) in
+/// memory with no output. Split a larger study into several sweeps.
+pub const MAX_RUNS: usize = 100_000;
 
 /// A loaded sweep: where it came from and its runs in order.
 #[derive(Debug, Clone)]
@@ -47,6 +55,8 @@ pub struct Sweep {
     pub file: PathBuf,
     /// Every dotted key that varies, in column order.
     pub keys: Vec<String>,
+    /// The keys each `[[list]]` entry sets, in list order.
+    pub list_keys: Vec<Vec<String>>,
     /// The runs, in id order.
     pub runs: Vec<SweepRun>,
 }
@@ -58,7 +68,7 @@ fn invalid(file: &Path, key: &str, reason: impl Into<String>) -> ScenarioError {
 /// Reads a sweep file and expands it into runs. Scenario contents are not checked here; see
 /// [`super::execute::check_runs`].
 pub fn load_sweep(file: &Path) -> Result<Sweep, ScenarioError> {
-    let text = std::fs::read_to_string(file).map_err(|source| ScenarioError::Io { file: file.into(), source })?;
+    let text = crate::scenario::read_text(file)?;
     let table: toml::Table = text
         .parse()
         .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.into(), message: e.to_string() })?;
@@ -83,21 +93,33 @@ pub fn load_sweep(file: &Path) -> Result<Sweep, ScenarioError> {
             }
         }
     }
+    // Counted before anything is expanded, saturating: a hostile grid cannot allocate.
+    let count = spec
+        .grid
+        .values()
+        .map(Vec::len)
+        .chain([spec.scenarios.len(), spec.list.len().max(1)])
+        .fold(1usize, usize::saturating_mul);
+    if count > MAX_RUNS {
+        return Err(invalid(file, "grid", format!("expands to {count} runs, more than {MAX_RUNS}: split the sweep")));
+    }
     let list = if spec.list.is_empty() { vec![BTreeMap::new()] } else { spec.list.clone() };
     let mut runs = Vec::new();
     for scenario in &spec.scenarios {
-        for set in &list {
+        for (index, set) in list.iter().enumerate() {
+            let list_index = (!spec.list.is_empty()).then_some(index);
             for combo in cartesian(&spec.grid) {
                 let mut overrides: Vec<Override> = Vec::new();
                 for (key, value) in combo.into_iter().chain(set.iter().map(|(k, v)| (k.clone(), v.clone()))) {
                     overrides.retain(|o| o.key != key);
                     overrides.push(Override { key, value });
                 }
-                runs.push(SweepRun { id: runs.len(), scenario: base.join(scenario), overrides });
+                runs.push(SweepRun { id: runs.len(), scenario: base.join(scenario), overrides, list_index });
             }
         }
     }
-    Ok(Sweep { file: file.into(), keys, runs })
+    let list_keys = spec.list.iter().map(|set| set.keys().cloned().collect()).collect();
+    Ok(Sweep { file: file.into(), keys, list_keys, runs })
 }
 
 /// Every combination of the grid's values, keys in order.
@@ -150,5 +172,16 @@ mod tests {
         assert!(err.to_string().contains("grid.controller.kp") && err.to_string().contains("empty"), "{err}");
         let err = load_sweep(&write(dir.path(), "scenarios = ['a.toml']\ngird = 1\n")).unwrap_err();
         assert!(err.to_string().contains("gird"), "{err}");
+    }
+
+    #[test]
+    fn a_million_runs_are_refused_before_expanding() {
+        let dir = tempfile::tempdir().unwrap();
+        let values = (0..100).map(|i| i.to_string()).collect::<Vec<_>>().join(",");
+        let text = format!("scenarios = ['a.toml']\n[grid]\na = [{values}]\nb = [{values}]\nc = [{values}]\n");
+        let started = std::time::Instant::now();
+        let err = load_sweep(&write(dir.path(), &text)).unwrap_err().to_string();
+        assert!(err.contains("sweep.toml") && err.contains("1000000 runs"), "{err}");
+        assert!(started.elapsed().as_secs_f64() < 2.0);
     }
 }

@@ -161,7 +161,10 @@ impl Default for InterrogatorConfig {
 
 impl Validate for InterrogatorConfig {
     fn validate(&self, at: &mut Checker) {
-        at.positive("sample_rate_hz", self.sample_rate_hz);
+        // 1 Hz to 10 kHz: the HYPERION si255 runs at 1 kHz (hardware.md), the fastest HYPERION
+        // models at 5 kHz; the twin draws every sample, so 1e9 Hz makes no progress, and below
+        // 1 Hz no control loop is fed.
+        at.in_range("sample_rate_hz", self.sample_rate_hz, 1.0, 10_000.0);
         at.non_negative("noise_pm", self.noise_pm);
         at.non_negative("quantization_pm", self.quantization_pm);
         at.section("spectral", &self.spectral);

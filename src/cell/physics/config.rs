@@ -252,19 +252,30 @@ impl Validate for PhysicsConfig {
     fn validate(&self, at: &mut Checker) {
         at.in_range("timestep_s", self.timestep_s, 1e-5, 0.05);
         at.in_range("impratio", self.impratio, 1.0, 1000.0);
-        at.require("iterations", self.iterations >= 1, || "must be >= 1".into());
-        at.positive("tolerance", self.tolerance);
-        at.require("ls_iterations", self.ls_iterations >= 1, || "must be >= 1".into());
-        at.non_negative("noslip_tolerance", self.noslip_tolerance);
-        at.positive("contact_timeconst_s", self.contact_timeconst_s);
-        at.positive("contact_dampratio", self.contact_dampratio);
+        // Solver iterations: MuJoCo's default is 100 (50 line search); 10 000 already costs seconds
+        // per step on this scene, more only hangs a run.
+        at.require("iterations", (1..=10_000).contains(&self.iterations), || {
+            format!("must be between 1 and 10000, got {}", self.iterations)
+        });
+        at.in_range("tolerance", self.tolerance, 1e-300, 1.0);
+        at.require("ls_iterations", (1..=10_000).contains(&self.ls_iterations), || {
+            format!("must be between 1 and 10000, got {}", self.ls_iterations)
+        });
+        at.in_range("noslip_tolerance", self.noslip_tolerance, 0.0, 1.0);
+        // A contact slower than 10 s would let objects sink through the table before it acts.
+        at.in_range("contact_timeconst_s", self.contact_timeconst_s, 1e-6, 10.0);
+        // Damping ratio: 1 is critical; 100 is already a contact that never rebounds.
+        at.in_range("contact_dampratio", self.contact_dampratio, 1e-3, 100.0);
         let [d0, dw, w] = self.contact_solimp;
         at.require("contact_solimp", (0.0..1.0).contains(&d0) && (d0..1.0).contains(&dw) && w > 0.0, || {
             format!("needs 0 <= d0 <= dwidth < 1 and width > 0, got {:?}", self.contact_solimp)
         });
-        at.positive("arm_max_speed_rad_s", self.arm_max_speed_rad_s);
-        at.positive("max_penetration_m", self.max_penetration_m);
-        at.positive("max_kinetic_energy_j", self.max_kinetic_energy_j);
+        // The UR5e's joints reach π rad/s (180 °/s, hardware.md); 10 rad/s leaves a margin.
+        at.in_range("arm_max_speed_rad_s", self.arm_max_speed_rad_s, 1e-3, 10.0);
+        // Divergence guards: a penetration of 10 cm is deeper than the objects are wide, and
+        // 1 MJ is a car at highway speed; larger guards never trip.
+        at.in_range("max_penetration_m", self.max_penetration_m, 1e-6, 0.1);
+        at.in_range("max_kinetic_energy_j", self.max_kinetic_energy_j, 1e-6, 1e6);
         at.section("rapier", &self.rapier);
         at.require("arm_mode", !(self.backend == Backend::Rapier && self.arm_mode == ArmMode::Dynamic), || {
             "the dynamic arm (UR5e servos) is MuJoCo-only; the rapier backend prescribes the arm's motion \
@@ -609,7 +620,11 @@ impl Validate for ObjectConfig {
             at.in_range("friction", mu, 0.0, 5.0);
         }
         if let Some([x, y]) = self.position_m {
-            at.finite("position_m", x + y);
+            // The object must stand within the UR5e's 850 mm reach of its base; 1 m leaves the
+            // table's edge a margin.
+            at.require("position_m", x.is_finite() && y.is_finite() && x.abs() <= 1.0 && y.abs() <= 1.0, || {
+                format!("x and y must lie within ±1 m of the arm's base (UR5e reach 0.85 m), got [{x}, {y}]")
+            });
         }
     }
 }

@@ -13,7 +13,9 @@
 //!   sample older than `arm_stale_s`, motor positions older than `dxl_reply_timeout`, the arm
 //!   leaving running/normal mode, or the follow program no longer playing (stopped on the
 //!   pendant), fails `read`; the runner then calls [`Cell::deactivate`];
-//! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way;
+//! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way (the CLI
+//!   uses [`crate::interrupt`] instead, which the runner checks every tick: Ctrl-C, SIGTERM and
+//!   SIGHUP alike);
 //! - `deactivate` (every exit path): enable flag 0 → the URScript program `stopj`s the arm; the
 //!   bus's IO thread stops and the gripper's goal = present position with torque ON (holds the
 //!   object); see [`super::dxl`].

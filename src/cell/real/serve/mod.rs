@@ -25,6 +25,7 @@ use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 pub use twin::{DeviceState, TwinStatus};
 
@@ -47,7 +48,17 @@ pub struct ServeConfig {
     /// stand in for dedicated hardware; on a shared machine a `SCHED_FIFO` priority keeps them from
     /// waiting behind other processes, and a CPU of their own keeps them off the control thread's.
     pub realtime: RealtimeOptions,
+    /// An RTDE or HYPERION command connection on which nothing is received or sent for this long is
+    /// closed (default [`IDLE_TIMEOUT`]); see `docs/hardware.md`.
+    pub idle_timeout: Duration,
 }
+
+/// How long an RTDE or HYPERION command connection may stay silent both ways before the virtual
+/// device closes it: 30 s. Why: a live client talks far more often (ours sends RTDE inputs every
+/// tick and takes an RTDE output package every millisecond once started; a HYPERION command is a
+/// request and its reply on a fresh connection), so 30 s of silence is a client that is gone
+/// or stuck, and each such connection would otherwise hold a socket and a task for ever.
+pub const IDLE_TIMEOUT: Duration = Duration::from_secs(30);
 
 impl ServeConfig {
     /// The real devices' ports on 127.0.0.1.
@@ -60,6 +71,7 @@ impl ServeConfig {
             stream_port: 51972,
             period_s: 1e-3,
             realtime: RealtimeOptions::default(),
+            idle_timeout: IDLE_TIMEOUT,
         }
     }
 

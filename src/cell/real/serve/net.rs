@@ -38,9 +38,10 @@ pub async fn listen_all(
     let command = bind(c.command_port).await?;
     let stream = bind(c.stream_port).await?;
     let addrs = [rtde.local_addr()?, script.local_addr()?, command.local_addr()?, stream.local_addr()?];
+    let idle = c.idle_timeout;
     {
         let (state, ticks) = (state.clone(), ticks.clone());
-        tokio::spawn(accept(rtde, move |s| serve_rtde(s, state.clone(), ticks.clone())));
+        tokio::spawn(accept(rtde, move |s| serve_rtde(s, state.clone(), ticks.clone(), idle)));
     }
     {
         let state = state.clone();
@@ -48,7 +49,7 @@ pub async fn listen_all(
     }
     {
         let state = state.clone();
-        tokio::spawn(accept(command, move |s| serve_commands(s, state.clone())));
+        tokio::spawn(accept(command, move |s| serve_commands(s, state.clone(), idle)));
     }
     tokio::spawn(accept(stream, move |s| serve_stream(s, state.clone(), ticks.clone())));
     Ok(addrs)
@@ -72,7 +73,8 @@ where
 }
 
 /// One RTDE connection: replies to requests; data packages on each twin tick while started.
-async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>) {
+/// Closed after `idle` with nothing received or sent (a started session sends every tick).
+async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>, idle: Duration) {
     let id = {
         let mut s = lock(&state);
         s.next_session += 1;
@@ -81,11 +83,14 @@ async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Rece
     let mut session = ServerSession::new(id, ServerConfig::default());
     let mut buf = Vec::new();
     let mut chunk = vec![0u8; 16 * 1024];
+    let mut last_activity = tokio::time::Instant::now();
     loop {
         let out = tokio::select! {
+            () = tokio::time::sleep_until(last_activity + idle) => break,
             r = socket.read(&mut chunk) => match r {
                 Ok(n) if n > 0 => {
                     buf.extend_from_slice(&chunk[..n]);
+                    last_activity = tokio::time::Instant::now();
                     let mut s = lock(&state);
                     match session.feed(&mut buf, &mut s.inputs) {
                         Ok(out) if buf.len() <= MAX_PENDING => out,
@@ -110,8 +115,11 @@ async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Rece
                 out
             }
         };
-        if !out.is_empty() && socket.write_all(&out).await.is_err() {
-            break;
+        if !out.is_empty() {
+            if socket.write_all(&out).await.is_err() {
+                break;
+            }
+            last_activity = tokio::time::Instant::now();
         }
     }
     lock(&state).inputs.release(id);
@@ -138,13 +146,14 @@ async fn serve_script(mut socket: TcpStream, state: Shared) {
     }
 }
 
-/// HYPERION commands: one reply per request; a malformed request closes the connection.
-async fn serve_commands(mut socket: TcpStream, state: Shared) {
+/// HYPERION commands: one reply per request; a malformed request, or `idle` without a byte,
+/// closes the connection.
+async fn serve_commands(mut socket: TcpStream, state: Shared, idle: Duration) {
     let mut buf = Vec::new();
     let mut chunk = [0u8; 4096];
     loop {
-        match socket.read(&mut chunk).await {
-            Ok(n) if n > 0 => buf.extend_from_slice(&chunk[..n]),
+        match tokio::time::timeout(idle, socket.read(&mut chunk)).await {
+            Ok(Ok(n)) if n > 0 => buf.extend_from_slice(&chunk[..n]),
             _ => return,
         }
         let reply = lock(&state).interrogator.feed(&mut buf);
