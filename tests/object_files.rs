@@ -121,3 +121,27 @@ fn a_missing_file_or_an_object_without_name_or_file_is_an_error_naming_the_key()
     assert!(!o.status.success());
     assert!(stderr(&o).contains("object.name") && stderr(&o).contains("`file`"), "{}", stderr(&o));
 }
+
+#[test]
+fn the_shipped_mesh_object_runs_and_a_mesh_that_does_not_load_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let bottle = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bottle.toml");
+    let (o, held) = run(&bottle, &dir.path().join("on"), &["--feedback", "on"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(held["outcome"], "held", "{held}");
+    assert!((held["mass_kg"].as_f64().unwrap() - 0.23).abs() < 1e-9, "{held}");
+    let (_, slick) = run(&bottle, &dir.path().join("slick"), &["--set", "object.friction=0.02"]);
+    assert_eq!(slick["outcome"], "dropped", "{slick}");
+    // rapier takes no meshes: refused by name before anything runs.
+    let (o, _) = run(&bottle, &dir.path().join("rapier"), &["--backend", "rapier"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("mesh geom `object_base`"), "{}", stderr(&o));
+    // A user's mesh object whose mesh file is missing.
+    let text =
+        DOWEL.replace("<worldbody>", "<asset><mesh name=\"foot\" file=\"meshes/foot.obj\"/></asset>\n  <worldbody>");
+    let lab = lab(&text.replace("type=\"cylinder\" size=\"0.04 0.01\"", "type=\"mesh\" mesh=\"foot\""));
+    let (o, _) = run(&lab.path().join("scenario.toml"), &lab.path().join("out"), &[]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(err.contains("dowel.xml") && err.contains("foot.obj"), "{err}");
+}

@@ -75,3 +75,35 @@ fn mujoco_python_opens_the_scene_and_the_object_stays_put() {
         assert!(moved < 1e-3, "{object}: the object moved {moved} m in the first second: {r}");
     }
 }
+
+/// The finger, pad, arm and table are read at run time from `physics.models_dir`: an edit to a copy
+/// of models/ shows in the scene without a rebuild, and a folder without the parts is an error
+/// naming the file.
+#[test]
+fn the_scene_parts_are_read_from_the_models_folder_at_run_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = dir.path().join("models");
+    std::fs::create_dir_all(&models).unwrap();
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    for part in ["finger.xml", "finger_segment.xml", "sensor_pad.xml", "ur5e.xml", "table.xml"] {
+        std::fs::copy(shipped.join(part), models.join(part)).unwrap();
+    }
+    let finger = std::fs::read_to_string(models.join("finger.xml")).unwrap();
+    let edited = finger.replace("size=\"0.005 0.035 0.012\"", "size=\"0.005 0.030 0.012\"");
+    assert_ne!(finger, edited, "the palm's size is where the test expects it");
+    std::fs::write(models.join("finger.xml"), edited).unwrap();
+    let set = format!("physics.models_dir=\"{}\"", models.display());
+    let path = export(dir.path(), "scenarios/crimper.toml", &["--set", &set]);
+    assert!(std::fs::read_to_string(path).unwrap().contains("size=\"0.005 0.030 0.012\""));
+    std::fs::remove_file(models.join("table.xml")).unwrap();
+    let o = tendril(&[
+        "scene",
+        "scenarios/crimper.toml",
+        "--set",
+        &set,
+        "--out",
+        dir.path().join("x.xml").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("table.xml"), "{}", stderr(&o));
+}

@@ -229,6 +229,8 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     let mut actuator = String::new();
     let mut tendon = String::new();
     let mut sensor = String::new();
+    // The object's assets (meshes), with their files already made absolute by ObjectModel.
+    let asset = object.as_ref().map_or("", |o| section(&o.mjcf, "asset")).to_string();
 
     if spec.object.is_some() {
         let table = part(models, "table.xml")?.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
@@ -248,7 +250,7 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     sensor.push_str(section(&finger_doc, "sensor"));
 
     let xml = format!(
-        "<mujoco model=\"tendril_cell\">\n  {header}\n  <worldbody>{worldbody}</worldbody>\n  \
+        "<mujoco model=\"tendril_cell\">\n  {header}\n  <asset>{asset}</asset>\n  <worldbody>{worldbody}</worldbody>\n  \
          <tendon>{tendon}</tendon>\n  <actuator>{actuator}</actuator>\n  \
          <sensor>{sensor}</sensor>\n</mujoco>\n",
         header = header(&spec.physics),

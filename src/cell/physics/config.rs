@@ -564,7 +564,7 @@ impl ObjectConfig {
                     file: source.clone(),
                     what: format!("cannot read: {e}"),
                 })?;
-                ObjectModel::from_mjcf(&source, &text)
+                ObjectModel::from_mjcf_in(&source, &text, file.parent())
             }
             (None, Some(name)) => {
                 let shipped: ObjectName =

@@ -29,7 +29,21 @@ pub struct ObjectModel {
 impl ObjectModel {
     /// Compiles `mjcf` (from `source`), checks the object contract and reads its figures. A broken
     /// file is a [`PhysicsError::Object`] naming the source and what is wrong.
+    ///
+    /// Asset files the text names (`<mesh file="...">`) are relative to `dir`, the object file's
+    /// folder; they are made absolute here, so the scene that includes the object finds them
+    /// wherever it runs.
     pub fn from_mjcf(source: &str, mjcf: &str) -> Result<ObjectModel, PhysicsError> {
+        Self::from_mjcf_in(source, mjcf, None)
+    }
+
+    /// As [`ObjectModel::from_mjcf`], for a file in `dir`.
+    pub fn from_mjcf_in(source: &str, mjcf: &str, dir: Option<&std::path::Path>) -> Result<ObjectModel, PhysicsError> {
+        let text = match dir {
+            Some(dir) => absolute_files(mjcf, dir),
+            None => mjcf.to_string(),
+        };
+        let mjcf = text.as_str();
         let broken = |what: String| PhysicsError::Object { file: source.to_string(), what };
         let m = MjModel::from_xml_string(mjcf).map_err(|e| broken(format!("MuJoCo cannot compile it: {e:?}")))?;
         let find = |kind, kind_name: &str, name: &str| {
@@ -73,6 +87,27 @@ impl ObjectModel {
     }
 }
 
+/// `mjcf` with every relative `file="..."` attribute taken from `dir`.
+fn absolute_files(mjcf: &str, dir: &std::path::Path) -> String {
+    const ATTR: &str = " file=\"";
+    let mut out = String::with_capacity(mjcf.len());
+    let mut rest = mjcf;
+    while let Some(at) = rest.find(ATTR) {
+        let start = at + ATTR.len();
+        let Some(len) = rest[start..].find('"') else { break };
+        let value = &rest[start..start + len];
+        out.push_str(&rest[..start]);
+        if std::path::Path::new(value).is_relative() {
+            out.push_str(&dir.join(value).display().to_string());
+        } else {
+            out.push_str(value);
+        }
+        rest = &rest[start + len..];
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,6 +124,15 @@ mod tests {
         assert!((o.mass_kg - 0.3).abs() < 1e-12);
         assert_eq!(o.grip_radius_m, 0.015);
         assert_eq!(o.wrap_height_m, 0.08);
+    }
+
+    #[test]
+    fn relative_asset_files_are_taken_from_the_object_folder() {
+        let text = r#"<mesh name="a" file="meshes/a.obj"/><mesh name="b" file="/abs/b.stl"/>"#;
+        assert_eq!(
+            absolute_files(text, std::path::Path::new("/lab/objects")),
+            r#"<mesh name="a" file="/lab/objects/meshes/a.obj"/><mesh name="b" file="/abs/b.stl"/>"#
+        );
     }
 
     #[test]

@@ -280,6 +280,15 @@ impl RapierWorld {
                 _mjtGeomBase::mjGEOM_CAPSULE => (ColliderBuilder::capsule_z(s1, s0), local),
                 _mjtGeomBase::mjGEOM_CYLINDER => (ColliderBuilder::cylinder(s1, s0), local * along_z),
                 _mjtGeomBase::mjGEOM_PLANE => (ColliderBuilder::halfspace(Unit::new_unchecked(Vector::Z)), local),
+                // Refused by name: a convex hull of MuJoCo's mesh vertices was tried and let the shipped
+                // bottle sink through the table (2.5 cm in 0.2 s); until that is understood, a mesh
+                // object runs on MuJoCo only.
+                _mjtGeomBase::mjGEOM_MESH => {
+                    return Err(unsupported(format!(
+                        "mesh geom `{}` (mesh objects run on the mujoco backend only)",
+                        self.geom_names[g]
+                    )));
+                }
                 other => return Err(unsupported(format!("{other:?} geom `{}`", self.geom_names[g]))),
             };
             let collider = builder
