@@ -145,3 +145,23 @@ fn the_shipped_mesh_object_runs_and_a_mesh_that_does_not_load_is_named() {
     let err = stderr(&o);
     assert!(err.contains("dowel.xml") && err.contains("foot.obj"), "{err}");
 }
+
+/// A shipped object read from models/ at run time and the copy built into the binary are the same
+/// model: a scenario with no models/ beside it (the built-in copies) gives the same trace, byte for
+/// byte, as the repository's (the files, found at run time).
+#[test]
+fn the_files_and_the_built_in_copies_give_the_same_trace() {
+    let dir = tempfile::tempdir().unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/hammer.toml");
+    let alone = dir.path().join("hammer.toml");
+    std::fs::copy(&repo, &alone).unwrap();
+    let short = ["--feedback", "off", "--set", "task.grasp_s=4"];
+    let (o, files) = run(&repo, &dir.path().join("files"), &short);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, built_in) = run(&alone, &dir.path().join("built-in"), &short);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(files["effective_scenario"]["object"]["file"].is_string(), "read from models/: {files}");
+    assert!(built_in["effective_scenario"]["object"].get("file").is_none(), "built in: {built_in}");
+    let trace = |d: &str| std::fs::read(dir.path().join(d).join("trace.csv")).unwrap();
+    assert!(trace("files").len() > 10_000 && trace("files") == trace("built-in"));
+}

@@ -35,12 +35,18 @@ pub struct SceneArgs {
     /// Where to write the MJCF.
     #[arg(long, default_value = "scene.xml")]
     out: PathBuf,
+    /// Folder of the scene's model parts [default: models/ beside the scenario's folder, else the
+    /// built-in copies]; `physics.models_dir`.
+    #[arg(long)]
+    models: Option<PathBuf>,
 }
 
 /// `tendril scene`: the assembled scene as one MJCF MuJoCo's own tools open, with the start state
 /// as keyframe `start`.
 pub fn scene(a: SceneArgs) -> anyhow::Result<ExitCode> {
-    let s: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&a.scenario, &a.set)?;
+    let mut overrides = a.set.clone();
+    overrides.extend(a.models.as_deref().map(Override::models_dir));
+    let s: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&a.scenario, &overrides)?;
     let model = crate::cell::physics::SceneModel::build(&s.scene_spec())?;
     let xml = crate::cell::physics::export::standalone_xml(&model)?;
     std::fs::write(&a.out, xml).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", a.out.display()))?;

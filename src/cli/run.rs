@@ -28,6 +28,10 @@ pub struct RunArgs {
     /// The twin's physics engine, `mujoco` or `rapier` (the scenario's `physics.backend`).
     #[arg(long)]
     backend: Option<crate::cell::physics::Backend>,
+    /// Folder of the scene's model parts (finger.xml, ur5e.xml, ...) [default: models/ beside the
+    /// scenario's folder, else the built-in copies]; `physics.models_dir`.
+    #[arg(long)]
+    models: Option<PathBuf>,
     /// Which cell runs the task: the twin (`sim`) or the devices (`real`).
     #[arg(long, value_parser = ["sim", "real"], default_value = "sim")]
     hardware: String,
@@ -48,6 +52,7 @@ impl RunArgs {
             o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
         }
         o.extend(self.backend.map(Override::backend));
+        o.extend(self.models.as_deref().map(Override::models_dir));
         o
     }
 }

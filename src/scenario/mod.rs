@@ -103,8 +103,8 @@ pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: 
     if let Some((key, reason)) = check_magnitudes(&table) {
         return Err(ScenarioError::Invalid { file: file.into(), key, reason });
     }
-    paths::resolve_object(&mut table, file);
     paths::resolve_models(&mut table, file);
+    paths::resolve_object(&mut table, file);
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
         let key = if path == "." { "(top level)".to_string() } else { path };

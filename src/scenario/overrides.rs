@@ -18,6 +18,13 @@ impl Override {
     pub fn backend(backend: crate::cell::physics::Backend) -> Override {
         Override { key: "physics.backend".into(), value: toml::Value::String(backend.name().into()) }
     }
+
+    /// `physics.models_dir` from a command line's `--models DIR`: relative to the working
+    /// directory, as paths on a command line are (in a scenario file they are relative to the file).
+    pub fn models_dir(dir: &std::path::Path) -> Override {
+        let dir = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+        Override { key: "physics.models_dir".into(), value: toml::Value::String(dir.display().to_string()) }
+    }
 }
 
 impl std::str::FromStr for Override {

@@ -8,11 +8,18 @@ use std::path::Path;
 /// Resolves `[object]`'s paths against `scenario` (the file the table came from):
 /// - `object.file`, when relative, is taken from the scenario's folder;
 /// - `object.name` without a `file` is looked up as `models/objects/<name>.xml` beside the
-///   scenario's folder (the repository's layout: `scenarios/` next to `models/`), then in the
+///   scenario's folder (the repository's layout: `scenarios/` next to `models/`; first in
+///   `physics.models_dir` when given), then in the
 ///   scenario's own folder's `models/`; found, it becomes `object.file`, so the model is read at run
 ///   time and edits take effect without a rebuild. Not found, the name stays a built-in object
 ///   (or an error naming it, from validation).
 pub fn resolve_object(table: &mut toml::Table, scenario: &Path) {
+    // Run after `resolve_models`: a models folder given (or found) is searched first.
+    let models_objects = table
+        .get("physics")
+        .and_then(|p| p.get("models_dir"))
+        .and_then(|d| d.as_str())
+        .map(|d| Path::new(d).join("objects"));
     let Some(toml::Value::Table(object)) = table.get_mut("object") else { return };
     let dir = scenario.parent().unwrap_or(Path::new(""));
     if let Some(toml::Value::String(file)) = object.get("file") {
@@ -28,10 +35,37 @@ pub fn resolve_object(table: &mut toml::Table, scenario: &Path) {
     if name.is_empty() || name.contains(['/', '\\', '.']) {
         return;
     }
-    let candidates = [dir.join("../models/objects"), dir.join("models/objects")];
-    if let Some(found) = candidates.iter().map(|d| d.join(format!("{name}.xml"))).find(|p| p.is_file()) {
+    let candidates = models_objects.into_iter().chain([dir.join("../models/objects"), dir.join("models/objects")]);
+    if let Some(found) = candidates.map(|d| d.join(format!("{name}.xml"))).find(|p| p.is_file()) {
         let found = std::fs::canonicalize(&found).unwrap_or(found);
         object.insert("file".into(), toml::Value::String(found.display().to_string()));
+    }
+}
+
+/// Resolves `physics.models_dir` against `scenario`: a relative folder is taken from the scenario's
+/// folder; none given, `models/` beside the scenario's folder is used when it holds finger.xml.
+/// Only scenarios of a scene (those with an `[object]` or `[physics]` table) get one; the bench
+/// scenarios have no scene.
+pub fn resolve_models(table: &mut toml::Table, scenario: &Path) {
+    if !(table.contains_key("object") || table.contains_key("physics")) {
+        return;
+    }
+    let dir = scenario.parent().unwrap_or(Path::new(""));
+    let physics = table.entry("physics").or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let Some(physics) = physics.as_table_mut() else { return };
+    match physics.get("models_dir") {
+        Some(toml::Value::String(given)) if Path::new(given).is_relative() => {
+            let joined = dir.join(given);
+            physics.insert("models_dir".into(), toml::Value::String(joined.display().to_string()));
+        }
+        Some(_) => {}
+        None => {
+            let beside = dir.join("../models");
+            if beside.join("finger.xml").is_file() {
+                let beside = std::fs::canonicalize(&beside).unwrap_or(beside);
+                physics.insert("models_dir".into(), toml::Value::String(beside.display().to_string()));
+            }
+        }
     }
 }
 
@@ -70,32 +104,5 @@ mod tests {
         let mut t = table("[object]\nname = \"../scenarios/x\"\n");
         resolve_object(&mut t, &scenario);
         assert!(t["object"].get("file").is_none());
-    }
-}
-
-/// Resolves `physics.models_dir` against `scenario`: a relative folder is taken from the scenario's
-/// folder; none given, `models/` beside the scenario's folder is used when it holds finger.xml.
-/// Only scenarios of a scene (those with an `[object]` or `[physics]` table) get one; the bench
-/// scenarios have no scene.
-pub fn resolve_models(table: &mut toml::Table, scenario: &Path) {
-    if !(table.contains_key("object") || table.contains_key("physics")) {
-        return;
-    }
-    let dir = scenario.parent().unwrap_or(Path::new(""));
-    let physics = table.entry("physics").or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let Some(physics) = physics.as_table_mut() else { return };
-    match physics.get("models_dir") {
-        Some(toml::Value::String(given)) if Path::new(given).is_relative() => {
-            let joined = dir.join(given);
-            physics.insert("models_dir".into(), toml::Value::String(joined.display().to_string()));
-        }
-        Some(_) => {}
-        None => {
-            let beside = dir.join("../models");
-            if beside.join("finger.xml").is_file() {
-                let beside = std::fs::canonicalize(&beside).unwrap_or(beside);
-                physics.insert("models_dir".into(), toml::Value::String(beside.display().to_string()));
-            }
-        }
     }
 }
