@@ -12,9 +12,6 @@ use std::sync::Arc;
 
 /// The quaternion (w, x, y, z) of a turn by `yaw_deg` about the vertical.
 pub(crate) fn yaw_quaternion(yaw_deg: f64) -> [f64; 4] {
-    if yaw_deg == 0.0 {
-        return [1.0, 0.0, 0.0, 0.0];
-    }
     let half = yaw_deg.to_radians() / 2.0;
     [half.cos(), 0.0, 0.0, half.sin()]
 }
