@@ -38,6 +38,16 @@ pub const GROW_CLEARANCE_M: f64 = 0.001;
 /// load off the pad by ~10 %).
 pub const PALM_GAP_M: f64 = 0.0002;
 
+/// Tightest radius the strip may curl to \[m\] (each joint's upper limit is segment length / this,
+/// so the limit is a curvature, the same at any number of links). A stated choice: 8.75 mm, 2 rad
+/// per joint at 8 links as calibrated; tighter than every object's grip (12-14 mm), so it only
+/// stops the free tip curling onto itself.
+pub const MIN_CURL_RADIUS_M: f64 = 0.00875;
+/// Tightest radius the strip may bend backwards to \[m\] (joint lower limit = segment length /
+/// this). A stated choice: 58.3 mm, 0.3 rad per joint at 8 links as calibrated; the strip is
+/// curled by a tendon on one side and never bends far the other way.
+pub const MIN_BACK_RADIUS_M: f64 = 0.0175 / 0.3;
+
 /// Half the sensor pad's casing length along the strip \[m\] (12 mm casing, paper Sec. II).
 pub const PAD_HALF_LENGTH_M: f64 = 0.006;
 
@@ -142,8 +152,9 @@ pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, Physics
                 ("z", num(if i == 0 { 0.0 } else { -f.helix_slope * l })),
                 ("k_bend", num(f.bending_stiffness_n_m2 / l)),
                 ("d_bend", num(per_joint(f.bending_damping_n_m2_s / l))),
-                ("a_bend", num(per_joint(f.bending_armature_kg_m * l.powi(3)))),
-                ("max_curl", num(2.0)),
+                ("a_bend", num(per_joint(f.bending_armature_kg_m3 / l))),
+                ("min_curl", num(-per_joint(l / MIN_BACK_RADIUS_M))),
+                ("max_curl", num(per_joint(l / MIN_CURL_RADIUS_M))),
                 ("half_len", num(l / 2.0)),
                 ("half_width", num(f.width_m / 2.0)),
                 ("radius", num(r)),

@@ -317,18 +317,22 @@ pub struct FingerConfig {
     /// EI [N m^2 s]; each joint gets it / segment length [N m s/rad], as the stiffness does, so the
     /// strip's damping does not change with the number of links. As a time constant, damping / EI.
     /// TPU is a lossy elastomer (loss factor 0.1-0.3 at 1-10 Hz at room temperature, typical of
-    /// Shore 85-95A grades); see `bending_armature_kg_m` for why the value is set near critical.
+    /// Shore 85-95A grades); see `bending_armature_kg_m3` for why the value is set near critical.
     pub bending_damping_n_m2_s: f64,
-    /// Inertia added to each bending joint, as a_joint = this x segment length^3 [kg/m -> kg m^2].
+    /// Inertia against bending, per unit length, as the stiffness is: a_joint = this / segment
+    /// length [kg m^3 -> kg m^2], so the kinetic energy 1/2 sum a_i (dθ_i/dt)^2 is the continuum
+    /// 1/2 ∫ this (dκ/dt)^2 ds at any number of links (κ curvature, s arc length).
     /// Numerical, not physical: MuJoCo's soft contacts are as stiff as the effective mass behind
-    /// them, and a bare 1 g segment sank up to 12 mm into the objects at 5 ms. A joint's armature
-    /// seen at the middle of its segment is a mass a / (l/2)^2 = 4 x this x l: with the cubic
-    /// scaling every segment brings the same contact mass per metre of strip, so the wrap's
-    /// contacts are as stiff per unit length at any number of links (a fixed armature per joint
-    /// made finer fingers' contacts stiffer and stiffer), and the added inertia vanishes as the
-    /// links get shorter. 18.6589 kg/m is 1e-4 kg m^2 per joint at 8 links (17.5 mm), the value that kept
-    /// penetration near 1 mm there.
-    pub bending_armature_kg_m: f64,
+    /// them, and a bare 1 g segment sank up to 12 mm into the objects at 5 ms. Why this scaling:
+    /// a contact at arc length s on an armature-dominated chain sees the inverse effective mass
+    /// Σ_i d_i² / a_i over the joints between it and the root (d_i: lever arm); with a_i = c / l
+    /// that sum is Σ (k l)² l / c ≈ s³ / (3 c), the same at any link length l, so the contacts' stiffness
+    /// does not change with the discretisation. The earlier cubic scaling (a = c' l³, same mass per
+    /// segment) gave s³ / (3 c' l⁴): at 64 links the wrap's contacts were 4096 times softer than at
+    /// 8 and the objects slid out at the lift. 1.75e-6 kg m^3 is 1e-4 kg m^2 per joint at 8 links
+    /// (17.5 mm), the value that kept penetration near 1 mm there. With the bending stiffness it
+    /// sets one frequency for every bending mode, sqrt(EI / this) = 15 rad/s.
+    pub bending_armature_kg_m3: f64,
     /// Tendon offset from the strip's neutral axis \[m\] (moment arm of the tendon on each joint). 3 mm.
     pub moment_arm_m: f64,
     /// Instantaneous tendon-path stiffness K [N/m] (both SLS branches in parallel): tendon plus the soft
@@ -394,7 +398,7 @@ impl Default for FingerConfig {
             density_kg_m3: 1200.0,
             bending_stiffness_n_m2: 4e-4,
             bending_damping_n_m2_s: 3.5e-6,
-            bending_armature_kg_m: 18.658892128279884,
+            bending_armature_kg_m3: 1.75e-6,
             moment_arm_m: 0.003,
             tendon_stiffness_n_m: 3000.0,
             relaxed_fraction: 0.05,
@@ -432,7 +436,7 @@ impl Validate for FingerConfig {
         at.positive("density_kg_m3", self.density_kg_m3);
         at.non_negative("bending_stiffness_n_m2", self.bending_stiffness_n_m2);
         at.non_negative("bending_damping_n_m2_s", self.bending_damping_n_m2_s);
-        at.non_negative("bending_armature_kg_m", self.bending_armature_kg_m);
+        at.non_negative("bending_armature_kg_m3", self.bending_armature_kg_m3);
         at.positive("moment_arm_m", self.moment_arm_m);
         at.positive("tendon_stiffness_n_m", self.tendon_stiffness_n_m);
         at.in_range("relaxed_fraction", self.relaxed_fraction, 0.0, 1.0);
