@@ -5,10 +5,12 @@
 //! - [`hysteresis`]: Prandtl-Ishlinskii operators (forward model and its inverse).
 //! - [`gripper`]: motor angles to finger growth and tendon pull.
 //! - [`task`]: the pick-and-place sequence.
-//! - [`pid`]: the force controller (output: twine motor speed).
+//! - [`controller`]: the force-controller seam ([`controller::ForceController`]) and `[controller]`.
+//! - [`pid`]: the paper's force controller, a PID (output: twine motor speed).
 //! - [`trajectory`]: joint-space moves within the paper's speed and acceleration limits.
 //! - [`slip`]: slip and loss detection from the force estimate.
 
+pub mod controller;
 pub mod estimate;
 pub mod gripper;
 pub mod hysteresis;

@@ -4,8 +4,8 @@
 //! Each tick the sequencer takes the cell's state and the force estimate and returns the
 //! command. It never sees the true force: control runs on the sensor, as on the real cell.
 
+use super::controller::{ArmMotion, ControlContext, ForceController};
 use super::gripper::GripperConfig;
-use super::pid::Pid;
 use super::trajectory::{JointLimits, JointMove};
 use crate::hardware::{ARM_JOINTS, CellCommand, CellState};
 use crate::scenario::{Checker, Validate};
@@ -210,11 +210,11 @@ pub struct TickDecision {
 }
 
 /// Runs the task. Create one per run.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct TaskSequencer {
     task: TaskConfig,
     gripper: GripperConfig,
-    pid: Pid,
+    controller: Box<dyn ForceController>,
     setpoint_n: f64,
     feedback_while_moving: bool,
     phase: Phase,
@@ -233,18 +233,19 @@ fn radians(deg: &[f64; ARM_JOINTS]) -> [f64; ARM_JOINTS] {
 impl TaskSequencer {
     /// A sequencer at the start of the task. `feedback_while_moving` keeps the force
     /// controller on during the arm's moves (the paper's second mode) or switches it off
-    /// before the arm moves (the first mode).
+    /// before the arm moves (the first mode). `controller` is the force controller (see
+    /// [`crate::control::controller`]).
     pub fn new(
         task: TaskConfig,
         gripper: GripperConfig,
-        pid: Pid,
+        controller: Box<dyn ForceController>,
         setpoint_n: f64,
         feedback_while_moving: bool,
     ) -> Self {
         TaskSequencer {
             task,
             gripper,
-            pid,
+            controller,
             setpoint_n,
             feedback_while_moving,
             phase: Phase::Home,
@@ -292,11 +293,11 @@ impl TaskSequencer {
         if phase == Phase::Lift {
             self.motion_start_s = Some(now);
             if !self.feedback_while_moving {
-                self.pid.reset();
+                self.controller.reset();
             }
         }
         if phase == Phase::Grasp {
-            self.pid.reset();
+            self.controller.reset();
         }
     }
 
@@ -348,7 +349,9 @@ impl TaskSequencer {
         match self.phase {
             Phase::Grow => self.growth_m = (self.growth_m + self.task.growth_speed_m_s * dt_s).min(self.task.growth_m),
             Phase::Wrap => self.twine_deg += self.task.wrap_speed_deg_s * dt_s,
-            Phase::Release => self.twine_deg = (self.twine_deg - self.pid.config().max_speed_deg_s * dt_s).max(0.0),
+            Phase::Release => {
+                self.twine_deg = (self.twine_deg - self.controller.max_speed_deg_s() * dt_s).max(0.0);
+            }
             _ => {}
         }
         if controller_on {
@@ -356,7 +359,14 @@ impl TaskSequencer {
             let tighten = self.setpoint_n > force_n;
             let blocked =
                 (tighten && self.twine_deg >= self.gripper.twine_max_deg) || (!tighten && self.twine_deg <= 0.0);
-            controller_output = self.pid.update(self.setpoint_n, force_n, dt_s, blocked);
+            // What the task knows of the arm's motion: the plan at this tick (still while it holds).
+            let arm = self.arm_move.as_ref().map_or_else(ArmMotion::default, |m| ArmMotion {
+                qd_rad_s: m.sample(elapsed).1,
+                qdd_rad_s2: m.acceleration(elapsed),
+            });
+            let context =
+                ControlContext { setpoint_n: self.setpoint_n, force_n, dt_s, phase: self.phase, blocked, arm };
+            controller_output = self.controller.update(&context);
             self.twine_deg += controller_output * dt_s;
         }
         self.twine_deg = self.twine_deg.clamp(0.0, self.gripper.twine_max_deg);
@@ -377,7 +387,7 @@ impl TaskSequencer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::control::pid::PidConfig;
+    use crate::control::pid::{Pid, PidConfig};
     use crate::signals::Wavelengths;
 
     /// A toy plant: force grows linearly with twine past first contact at 60°, and relaxes by
@@ -385,7 +395,7 @@ mod tests {
     fn run_toy(feedback: bool, creep_n_s: f64) -> (Vec<Phase>, Vec<(f64, Phase, f64)>) {
         let task = TaskConfig::default();
         let gripper = GripperConfig::default();
-        let mut seq = TaskSequencer::new(task, gripper, Pid::new(PidConfig::default()), 1.0, feedback);
+        let mut seq = TaskSequencer::new(task, gripper, Box::new(Pid::new(PidConfig::default())), 1.0, feedback);
         let dt = 0.01;
         let mut twine_deg: f64 = 0.0;
         let mut offset: f64 = 0.0;

@@ -108,6 +108,22 @@ impl JointMove {
         }
     }
 
+    /// Planned joint accelerations [rad/s²] at time `t` after the start: constant while the
+    /// profile ramps up or down, zero while it cruises and outside the move.
+    pub fn acceleration(&self, t: f64) -> [f64; ARM_JOINTS] {
+        let (w, ta, tt) = (self.peak_rate, self.ramp_s, self.duration_s);
+        let path_accel = if w == 0.0 || ta <= 0.0 || !(0.0..tt).contains(&t) {
+            0.0
+        } else if t < ta {
+            w / ta
+        } else if t <= tt - ta {
+            0.0
+        } else {
+            -w / ta
+        };
+        std::array::from_fn(|j| path_accel * (self.to[j] - self.from[j]))
+    }
+
     /// Joint positions \[rad\] and velocities [rad/s] at time `t` after the start.
     pub fn sample(&self, t: f64) -> ([f64; ARM_JOINTS], [f64; ARM_JOINTS]) {
         let (s, rate) = self.progress(t);
@@ -176,5 +192,24 @@ mod tests {
         let m = JointMove::plan(q, q, &JointLimits::default(), 2.0);
         assert_eq!(m.duration_s(), 2.0);
         assert_eq!(m.sample(1.0), (q, [0.0; 6]));
+        assert_eq!(m.acceleration(1.0), [0.0; 6]);
+    }
+
+    #[test]
+    fn acceleration_is_the_derivative_of_the_planned_velocity() {
+        let to = [0.0, 20.0 * DEG, -10.0 * DEG, 0.0, 0.0, 0.0];
+        for min_s in [0.0, 10.0] {
+            let m = JointMove::plan([0.0; 6], to, &JointLimits::default(), min_s);
+            let (h, tt) = (1e-6, m.duration_s());
+            for t in [0.05 * tt, 0.3 * tt, 0.5 * tt, 0.7 * tt, 0.95 * tt] {
+                let (v0, v1) = (m.sample(t - h).1, m.sample(t + h).1);
+                let a = m.acceleration(t);
+                for j in 0..ARM_JOINTS {
+                    assert!(((v1[j] - v0[j]) / (2.0 * h) - a[j]).abs() < 1e-6, "t {t} joint {j}");
+                }
+            }
+            assert_eq!(m.acceleration(-1.0), [0.0; 6]);
+            assert_eq!(m.acceleration(tt + 1.0), [0.0; 6]);
+        }
     }
 }

@@ -5,9 +5,9 @@
 use super::drop_watch::DropWatch;
 use super::metrics::{ControlMetrics, control_metrics};
 use super::trace::{TraceRow, TraceWriter};
-use crate::control::estimate::{ForceCalibration, ForceEstimator};
+use crate::control::controller::{ControllerConfig, ForceController};
+use crate::control::estimate::{Estimate, EstimateError, ForceCalibration, ForceEstimator};
 use crate::control::gripper::GripperConfig;
-use crate::control::pid::{Pid, PidConfig};
 use crate::control::slip::{SlipConfig, SlipDetector, SlipEvents};
 use crate::control::task::{Phase, TaskConfig, TaskSequencer};
 use crate::hardware::{Cell, CellError};
@@ -23,8 +23,8 @@ pub struct ControlPlan {
     pub feedback: bool,
     /// Control loop rate \[Hz\].
     pub rate_hz: f64,
-    /// PID gains and limits.
-    pub pid: PidConfig,
+    /// The force controller (`[controller]`).
+    pub controller: ControllerConfig,
     /// Calibration used by the estimator (eq. 8).
     pub calibration: ForceCalibration,
     /// Poses and timing.
@@ -73,17 +73,39 @@ pub struct RunReport {
     pub cell_time_s: f64,
     /// The error that ended the run, with its time.
     pub error: Option<String>,
+    /// Sensor samples skipped because they gave no estimate (the last valid one was held).
+    pub invalid_samples: u64,
     /// Every tick, as written to the trace.
     pub rows: Vec<TraceRow>,
 }
 
+/// Consecutive invalid sensor samples (no estimate: non-finite, or below the calibration curve)
+/// that end a run. A lone bad sample is skipped and the last valid estimate held; 10 ticks are
+/// 0.1 s at the default 100 Hz control rate, a twentieth of the closed loop's time constant
+/// (≈ 2 s): holding the estimate that long cannot move the grip far (at the PID's 90 °/s limit the
+/// twine turns 9°, ≈ 0.2 N on the finger's force gain), while a sensor that stays bad longer —
+/// a broken fibre, an interrogator out of lock — leaves the loop blind and must stop the run.
+pub const MAX_CONSECUTIVE_INVALID_SAMPLES: u32 = 10;
+
 /// Runs the task on `cell`, writing each tick to `trace` when given. The cell is configured,
 /// activated and, whatever happens, deactivated. Cell errors end the run with
-/// [`Outcome::Error`]; the rows up to the error are kept.
-pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut TraceWriter>) -> RunReport {
+/// [`Outcome::Error`]; the rows up to the error are kept. The force controller is the one
+/// `plan.controller` describes.
+pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, trace: Option<&mut TraceWriter>) -> RunReport {
+    run_task_with_controller(cell, plan, plan.controller.build(), trace)
+}
+
+/// As [`run_task`], with the force controller given (`plan.controller` is not used): any
+/// [`ForceController`], including one defined outside the crate.
+pub fn run_task_with_controller(
+    cell: &mut dyn Cell,
+    plan: &ControlPlan,
+    controller: Box<dyn ForceController>,
+    mut trace: Option<&mut TraceWriter>,
+) -> RunReport {
     let mut rows = Vec::new();
-    let mut sequencer =
-        TaskSequencer::new(plan.task.clone(), plan.gripper, Pid::new(plan.pid), plan.setpoint_n, plan.feedback);
+    let mut sequencer = TaskSequencer::new(plan.task.clone(), plan.gripper, controller, plan.setpoint_n, plan.feedback);
+    let mut invalid = InvalidSamples::default();
     let mut slip = SlipDetector::new(plan.slip);
     let mut drop_watch = DropWatch::default();
     let mut truth_drop: Option<Drop> = None;
@@ -103,16 +125,19 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
             }
             let state = cell.read()?;
             if sequencer.phase() == Phase::Home {
-                // Tare on the mean of the samples at home, finger retracted and untouched.
-                tare.add(state.wavelengths);
+                // Tare on the mean of the samples at home, finger retracted and untouched (a
+                // non-finite sample is left out: it would poison the mean for the whole run).
+                if state.wavelengths.fbg1_nm.is_finite() && state.wavelengths.fbg2_nm.is_finite() {
+                    tare.add(state.wavelengths);
+                }
                 let mean = tare.mean();
                 estimator.tare(mean);
                 unloaded_n = estimator.estimate(mean).map_or(0.0, |e| e.force_n);
                 sequencer.set_unloaded_reading(unloaded_n);
             }
-            let estimate = estimator.track(state.wavelengths).map_err(|e| CellError::Device {
+            let estimate = invalid.check(estimator.track(state.wavelengths)).map_err(|cause| CellError::Device {
                 device: "estimator".into(),
-                cause: format!("at t = {:.3} s: {e}", state.time_s),
+                cause: format!("at t = {:.3} s: {cause}", state.time_s),
             })?;
             let decision = sequencer.update(&state, estimate.force_n, dt);
             // Slip is watched while the arm carries the object, as in the paper.
@@ -178,7 +203,40 @@ pub fn run_task(cell: &mut dyn Cell, plan: &ControlPlan, mut trace: Option<&mut 
         metrics,
         cell_time_s: rows.last().map_or(0.0, |r| r.time_s),
         error,
+        invalid_samples: invalid.total,
         rows,
+    }
+}
+
+/// Skips invalid estimates, holding the last valid one, until too many come in a row.
+#[derive(Debug, Default)]
+struct InvalidSamples {
+    last_valid: Option<Estimate>,
+    consecutive: u32,
+    total: u64,
+}
+
+impl InvalidSamples {
+    /// The estimate to use this tick, or why the run must stop: no tare, or
+    /// [`MAX_CONSECUTIVE_INVALID_SAMPLES`] invalid samples in a row (or one before any valid).
+    fn check(&mut self, estimate: Result<Estimate, EstimateError>) -> Result<Estimate, String> {
+        match estimate {
+            Ok(e) => {
+                self.consecutive = 0;
+                self.last_valid = Some(e);
+                Ok(e)
+            }
+            Err(e @ EstimateError::NotTared) => Err(e.to_string()),
+            Err(e) => {
+                self.consecutive += 1;
+                self.total += 1;
+                match self.last_valid {
+                    Some(held) if self.consecutive < MAX_CONSECUTIVE_INVALID_SAMPLES => Ok(held),
+                    Some(_) => Err(format!("{} consecutive invalid samples, the last: {e}", self.consecutive)),
+                    None => Err(format!("no valid sample yet: {e}")),
+                }
+            }
+        }
     }
 }
 

@@ -14,9 +14,9 @@ use crate::cell::fbg::{InterrogatorConfig, SensorConfig};
 use crate::cell::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneSpec};
 use crate::cell::real::HardwareConfig;
 use crate::cell::sim::EnvironmentConfig;
+use crate::control::controller::ControllerConfig;
 use crate::control::estimate::ForceCalibration;
 use crate::control::gripper::GripperConfig;
-use crate::control::pid::PidConfig;
 use crate::control::slip::SlipConfig;
 use crate::control::task::TaskConfig;
 use crate::scenario::{Checker, Validate};
@@ -47,9 +47,9 @@ pub struct PickPlaceScenario {
     pub control_rate_hz: f64,
     /// The object.
     pub object: ObjectConfig,
-    /// PID gains and limits.
+    /// The force controller: `type` (default `"pid"`) and that type's gains and limits.
     #[serde(default)]
-    pub controller: PidConfig,
+    pub controller: ControllerConfig,
     /// Task poses and timing.
     #[serde(default)]
     pub task: TaskConfig,
@@ -180,7 +180,13 @@ impl PickPlaceScenario {
             // can start).
             mass_kg: self.object.mass_kg.unwrap_or_else(|| self.object.model().map_or(f64::NAN, |m| m.mass_kg)),
             feedback: self.feedback,
-            gains: Gains { kp: self.controller.kp, ki: self.controller.ki, kd: self.controller.kd },
+            controller_type: self.controller.type_name().into(),
+            // A controller without PID gains reports none (NaN, `null` in the summary).
+            gains: self.controller.pid().map_or(Gains { kp: f64::NAN, ki: f64::NAN, kd: f64::NAN }, |c| Gains {
+                kp: c.kp,
+                ki: c.ki,
+                kd: c.kd,
+            }),
             setpoint_n: self.setpoint_n,
             seed: self.seed,
             backend: backend.into(),
@@ -193,7 +199,7 @@ impl PickPlaceScenario {
             setpoint_n: self.setpoint_n,
             feedback: self.feedback,
             rate_hz: self.control_rate_hz,
-            pid: self.controller,
+            controller: self.controller.clone(),
             calibration: self.estimator.clone(),
             task: self.task.clone(),
             gripper: self.gripper,

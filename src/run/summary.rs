@@ -26,6 +26,9 @@ pub struct RunIdentity {
     pub mass_kg: f64,
     /// Force control kept on while the arm moves.
     pub feedback: bool,
+    /// The force controller's `type` (`"pid"`, ...).
+    #[serde(default)]
+    pub controller_type: String,
     /// PID gains.
     pub gains: Gains,
     /// Force setpoint \[N\].
@@ -65,6 +68,11 @@ pub struct RunSummary {
     pub real_time_factor: f64,
     /// The error that ended the run, with its time.
     pub error: Option<String>,
+    /// Sensor samples that gave no force estimate (non-finite, or below the calibration curve) and
+    /// were skipped, the last valid estimate held (see
+    /// [`crate::run::runner::MAX_CONSECUTIVE_INVALID_SAMPLES`]).
+    #[serde(default)]
+    pub invalid_samples: u64,
     /// MuJoCo's warnings during the run (see [`crate::mujoco_log`]), at most
     /// [`crate::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
     #[serde(default)]
@@ -108,6 +116,7 @@ impl RunSummary {
             wall_time_s,
             real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },
             error: report.error.clone(),
+            invalid_samples: report.invalid_samples,
             warnings: Vec::new(),
         }
     }
@@ -117,12 +126,13 @@ impl RunSummary {
 pub fn render_text(s: &RunSummary) -> String {
     let opt = |v: Option<f64>, unit: &str| v.map_or("-".to_string(), |v| format!("{v:.2} {unit}"));
     let mut out = format!(
-        "{} ({}, {:.0} g, setpoint {} N, feedback {}, Kp {} Ki {} Kd {}, seed {}, {})\n",
+        "{} ({}, {:.0} g, setpoint {} N, feedback {}, controller {}, Kp {} Ki {} Kd {}, seed {}, {})\n",
         s.run.scenario,
         s.run.object,
         s.run.mass_kg * 1e3,
         s.run.setpoint_n,
         if s.run.feedback { "on" } else { "off" },
+        s.run.controller_type,
         s.run.gains.kp,
         s.run.gains.ki,
         s.run.gains.kd,
@@ -136,6 +146,9 @@ pub fn render_text(s: &RunSummary) -> String {
     out += "\n";
     if let Some(e) = &s.error {
         out += &format!("  error              {e}\n");
+    }
+    if s.invalid_samples > 0 {
+        out += &format!("  invalid samples    {} skipped (last valid estimate held)\n", s.invalid_samples);
     }
     out += &format!("  rise time (90 %)   {}\n", opt(s.metrics.rise_time_90_s, "s"));
     out += &format!("  overshoot          {:.1} %\n", s.metrics.overshoot_pct);

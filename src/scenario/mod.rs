@@ -107,10 +107,17 @@ pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: 
     paths::resolve_object(&mut table, file);
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
-        let key = if path == "." { "(top level)".to_string() } else { path };
         // The TOML layer appends "in `key`" lines; the key is reported separately.
         let message = e.into_inner().to_string();
         let reason = message.lines().next().unwrap_or_default().trim().to_string();
+        // An error from inside a section read as a table (`deserialize_section`) carries the rest
+        // of its key.
+        let (path, reason) = match split_section_error(&reason) {
+            Some((inner, inner_reason)) if path == "." => (inner.to_string(), inner_reason.to_string()),
+            Some((inner, inner_reason)) => (format!("{path}.{inner}"), inner_reason.to_string()),
+            None => (path, reason),
+        };
+        let key = if path == "." { "(top level)".to_string() } else { path };
         ScenarioError::Invalid { file: file.into(), key, reason }
     })?;
     let mut checker = Checker::default();
@@ -119,4 +126,35 @@ pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: 
         None => Ok(value),
         Some((key, reason)) => Err(ScenarioError::Invalid { file: file.into(), key, reason }),
     }
+}
+
+/// Marks a [`section_error`] message: the key inside the section, then the reason.
+const SECTION_ERROR_MARK: char = '\u{1f}';
+
+/// An error on `key` inside a section that deserialises itself from a table (a tagged section such
+/// as `[controller]`): reported as `section.key`, like the errors of ordinary sections.
+pub fn section_error<E: serde::de::Error>(key: &str, reason: &str) -> E {
+    E::custom(format!("{SECTION_ERROR_MARK}{key}{SECTION_ERROR_MARK}{reason}"))
+}
+
+/// Deserialises the rest of a section read as a table into `T`; an error keeps its key inside the
+/// section (see [`section_error`]), so `[controller] kq = 1` is still refused at `controller.kq`.
+pub fn deserialize_section<T: DeserializeOwned, E: serde::de::Error>(table: toml::Table) -> Result<T, E> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        let message = e.into_inner().to_string();
+        let reason = message.lines().next().unwrap_or_default().trim().to_string();
+        match split_section_error(&reason) {
+            // Nested again: join the keys.
+            Some((inner, inner_reason)) if path != "." => section_error(&format!("{path}.{inner}"), inner_reason),
+            Some((inner, inner_reason)) => section_error(inner, inner_reason),
+            None if path == "." => E::custom(reason),
+            None => section_error(&path, &reason),
+        }
+    })
+}
+
+/// The (key, reason) of a [`section_error`] message.
+fn split_section_error(message: &str) -> Option<(&str, &str)> {
+    message.strip_prefix(SECTION_ERROR_MARK)?.split_once(SECTION_ERROR_MARK)
 }
