@@ -177,7 +177,7 @@ impl PushConfig {
         Onset { time_s: self.time_s, phase: self.phase, offset_s: self.offset_s }
     }
 
-    /// The world-frame force [N] for a push spread over `steps` physics steps of `dt_s`.
+    /// The world-frame force \[N\] for a push spread over `steps` physics steps of `dt_s`.
     pub fn force_n(&self, steps: usize, dt_s: f64) -> [f64; 3] {
         let magnitude = self.impulse_n_s / (steps.max(1) as f64 * dt_s);
         let (s, c) = self.direction_deg.to_radians().sin_cos();
@@ -269,7 +269,7 @@ impl DisturbanceSchedule {
         onset.resolve(|p| self.phase_starts.iter().find(|(q, _)| *q == p).map(|(_, t)| *t))
     }
 
-    /// The force on the object [N] for the physics step starting at `time_s` of length `dt_s`:
+    /// The force on the object \[N\] for the physics step starting at `time_s` of length `dt_s`:
     /// the push's force on the `steps(dt_s)` steps from its onset (a step belongs to the push when
     /// its start lies within half a step of the push's span), zero otherwise.
     pub fn push_force_n(&self, time_s: f64, dt_s: f64) -> Option<[f64; 3]> {
