@@ -54,3 +54,29 @@ fn slip_margin_holds_and_tightens_for_a_lift_at_the_limits() {
     let rest = |r: &RunReport| mean_force(r, Phase::Lift, -2.5, -2.0);
     assert_eq!(rest(&sm), rest(&pid), "at rest, with the default margins, it is the PID");
 }
+
+#[test]
+fn not_loosening_while_moving_keeps_the_crimper_through_a_knock() {
+    // The case on the crimper (seed 1): the arm at the paper's limits and a 0.3 N·s knock
+    // 1 s into the transfer. The knock saturates the pad; the PID loosens and loses the object,
+    // the feedforward (which does not loosen while the arm moves) keeps it.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml");
+    let knocked = |controller: &str| {
+        let overrides: Vec<tendril::scenario::Override> = [
+            format!("controller.type=\"{controller}\""),
+            "task.minimum_durations=false".into(),
+            "disturbance.push.impulse_n_s=0.3".into(),
+            "disturbance.push.phase=\"transfer\"".into(),
+            "disturbance.push.offset_s=1.0".into(),
+        ]
+        .iter()
+        .map(|o| o.parse().unwrap())
+        .collect();
+        let scenario = tendril::scenario::load(&path, &overrides).unwrap();
+        run_on_twin(&scenario, &Default::default(), None).unwrap().1
+    };
+    let pid = knocked("pid");
+    assert_eq!(pid.outcome, Outcome::Dropped);
+    assert_eq!(pid.drop.unwrap().phase, Phase::Transfer);
+    assert_eq!(knocked("feedforward").outcome, Outcome::Held);
+}

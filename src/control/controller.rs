@@ -299,6 +299,8 @@ mod tests {
             ("type = \"slip_margin\"\nlever_m = 5.0", "controller.lever_m"),
             ("type = \"slip_margin\"\nforce_gain_n_per_deg = inf", "controller.force_gain_n_per_deg"),
             ("type = \"slip_margin\"\nmax_speed_deg_s = 0.0", "controller.max_speed_deg_s"),
+            ("type = \"slip_margin\"\nmax_release_deg_s = -1.0", "controller.max_release_deg_s"),
+            ("type = \"feedforward\"\nmax_release_deg_s = 1000.0", "controller.max_release_deg_s"),
         ] {
             let (k, reason) = refused_at(text);
             assert_eq!(k, key, "{text}: {reason}");
