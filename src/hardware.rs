@@ -6,6 +6,7 @@
 //! Time comes from the cell: a simulation steps its physics in `wait_until`, a real cell sleeps.
 //! Code above this trait must not know which cell it runs on.
 
+use crate::control::task::Phase;
 use crate::signals::Wavelengths;
 use serde::Serialize;
 
@@ -128,6 +129,17 @@ pub trait Cell {
     /// Ground truth, when the cell is a simulation.
     fn ground_truth(&self) -> Option<GroundTruth> {
         None
+    }
+    /// Tells the cell that the task entered `phase` at cell time `time_s` (the runner calls it on
+    /// every phase change, before the tick's write). The twin times its scenario disturbances
+    /// (`[disturbance]`) from it; a real cell has none and ignores it.
+    fn phase_started(&mut self, _phase: Phase, _time_s: f64) {}
+    /// Whether the wavelengths of the last [`Cell::read`] are a new interrogator sample (`false`
+    /// when the interrogator delivered nothing since the read before, as in the twin's
+    /// `[disturbance.dropout]`). A real cell reports every read as new: its watchdog stops the run
+    /// on a stale stream instead.
+    fn sample_is_new(&self) -> bool {
+        true
     }
 }
 

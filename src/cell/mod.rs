@@ -4,6 +4,8 @@
 //! - [`fbg`]: the FBG forward model and interrogator (wavelengths from force and temperature).
 //! - [`sim`]: both behind [`crate::hardware::Cell`]: the twin.
 //! - [`real`]: the real devices' protocols.
+//! - [`disturbance`]: what the twin can inflict on a run (a push on the object, a sensor dropout).
+pub mod disturbance;
 pub mod fbg;
 pub mod physics;
 pub mod real;

@@ -4,9 +4,11 @@
 //! motor targets, exactly as on the real cell. In between, [`Cell::wait_until`] steps the physics
 //! and samples the sensor model at the interrogator's rate with the pad's true contact force.
 
+use super::disturbance::{DisturbanceConfig, DisturbanceSchedule};
 use super::fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
 use super::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel};
 use crate::control::gripper::GripperConfig;
+use crate::control::task::Phase;
 use crate::hardware::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
 use crate::scenario::{Checker, Validate};
 use crate::signals::Wavelengths;
@@ -61,6 +63,12 @@ pub struct SimCell {
     /// The physics readout after the last step, read once per tick by `read`, the sensor and
     /// the ground truth alike.
     readout: PhysicsReadout,
+    /// The scenario's disturbances (`[disturbance]`), empty by default.
+    disturbances: DisturbanceSchedule,
+    /// Whether the last sensor sampling delivered a new interrogator sample.
+    fresh_sample: bool,
+    /// Whether the object force is currently set (so it is cleared once, after the push).
+    pushing: bool,
 }
 
 impl SimCell {
@@ -101,7 +109,18 @@ impl SimCell {
             latest: Wavelengths { fbg1_nm: 0.0, fbg2_nm: 0.0 },
             next_sample_s: 0.0,
             readout: PhysicsReadout::default(),
+            disturbances: DisturbanceSchedule::default(),
+            fresh_sample: true,
+            pushing: false,
         }
+    }
+
+    /// Subjects the run to `disturbances` (`[disturbance]`): a push on the object, a gap in the
+    /// interrogator's samples. Phase-relative onsets resolve as the runner reports the phases
+    /// ([`Cell::phase_started`]).
+    pub fn with_disturbances(mut self, disturbances: DisturbanceConfig) -> SimCell {
+        self.disturbances = DisturbanceSchedule::new(disturbances);
+        self
     }
 
     /// The cell a pick-and-place scenario describes, over its compiled scene model.
@@ -114,6 +133,7 @@ impl SimCell {
             scenario.environment,
             scenario.seed,
         )
+        .with_disturbances(scenario.disturbance.clone())
     }
 
     fn scene(&self) -> &dyn Physics {
@@ -134,9 +154,16 @@ impl SimCell {
         self.readout = self.scene().readout();
         let now = self.readout.time_s;
         let force = self.readout.pad_force_n;
+        self.fresh_sample = false;
         while self.next_sample_s <= now + 1e-12 {
             let temperature = self.environment.temperature_at(self.next_sample_s);
-            self.latest = self.sensor.sample(force, temperature, dt);
+            // The sensor model runs through a dropout (its noise and thermal state advance); only
+            // the delivery is lost. The first sample (the activation's) is always delivered.
+            let sample = self.sensor.sample(force, temperature, dt);
+            if self.next_sample_s == 0.0 || !self.disturbances.sample_dropped(self.next_sample_s) {
+                self.latest = sample;
+                self.fresh_sample = true;
+            }
             self.next_sample_s += dt;
         }
     }
@@ -156,6 +183,8 @@ impl Cell for SimCell {
         self.scene = Some(self.model.start().map_err(Self::physics_error)?);
         self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
         self.next_sample_s = 0.0;
+        self.disturbances.restart();
+        self.pushing = false;
         self.lifecycle = Lifecycle::Inactive;
         Ok(())
     }
@@ -198,11 +227,27 @@ impl Cell for SimCell {
         require_state(self.lifecycle, Lifecycle::Active, "wait")?;
         let scene = self.scene.as_mut().expect("active implies configured");
         let half_step = 0.5 * scene.timestep();
+        let push = self.disturbances.has_push();
         while scene.time() < time_s - half_step {
+            if push {
+                let force = self.disturbances.push_force_n(scene.time(), scene.timestep());
+                if force.is_some() || self.pushing {
+                    scene.set_object_force(force.unwrap_or([0.0; 3])).map_err(Self::physics_error)?;
+                    self.pushing = force.is_some();
+                }
+            }
             scene.step().map_err(Self::physics_error)?;
         }
         self.sample_sensor();
         Ok(())
+    }
+
+    fn phase_started(&mut self, phase: Phase, time_s: f64) {
+        self.disturbances.phase_started(phase, time_s);
+    }
+
+    fn sample_is_new(&self) -> bool {
+        self.fresh_sample
     }
 
     fn ground_truth(&self) -> Option<GroundTruth> {

@@ -63,6 +63,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     // Ctrl-C, SIGTERM and SIGHUP: the safe stop, the trace whole and summary.json written.
     crate::interrupt::install()?;
     let (summary, _) = if a.hardware == "real" {
+        scenario.disturbance.refuse_on_real().map_err(anyhow::Error::msg)?;
         let config = a.devices.config(&scenario)?;
         // This thread runs the ticks; the cell's IO threads, started from it, inherit its priority.
         a.devices.realtime()?.apply_to_current_thread()?;

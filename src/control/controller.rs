@@ -9,7 +9,9 @@
 //! [`ControllerConfig`] variant (its name in [`ControllerConfig::TYPES`], its arm in
 //! `deserialize`, `validate` and [`ControllerConfig::build`]).
 
+use super::feedforward::{Feedforward, FeedforwardConfig};
 use super::pid::{Pid, PidConfig};
+use super::slip_margin::{SlipMargin, SlipMarginConfig};
 use super::task::Phase;
 use crate::hardware::ARM_JOINTS;
 use crate::scenario::{Checker, Validate};
@@ -22,6 +24,28 @@ pub struct ArmMotion {
     pub qd_rad_s: [f64; ARM_JOINTS],
     /// Planned joint accelerations [rad/s²].
     pub qdd_rad_s2: [f64; ARM_JOINTS],
+}
+
+/// What the task knows of the arm's moves ahead: the object-carrying moves (lift, transfer,
+/// lower) are planned from poses and limits known before the task starts, so a controller can act
+/// before the arm moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MoveOutlook {
+    /// Time until the arm starts moving the object \[s\]: counts down during the grasp, 0 while
+    /// the arm moves, +∞ when no move follows.
+    pub time_to_motion_s: f64,
+    /// Largest planned joint acceleration (over the joints and the move) of the current move, or
+    /// of the next while the arm is still [rad/s²]; 0 when no move follows.
+    pub peak_accel_rad_s2: f64,
+    /// Largest planned joint speed of the same move [rad/s]; 0 when no move follows.
+    pub peak_speed_rad_s: f64,
+}
+
+impl Default for MoveOutlook {
+    /// No move ahead.
+    fn default() -> Self {
+        MoveOutlook { time_to_motion_s: f64::INFINITY, peak_accel_rad_s2: 0.0, peak_speed_rad_s: 0.0 }
+    }
 }
 
 /// Everything a force controller is told each tick.
@@ -40,6 +64,8 @@ pub struct ControlContext {
     pub blocked: bool,
     /// The arm's planned joint velocities and accelerations at this tick.
     pub arm: ArmMotion,
+    /// The arm's moves ahead (or the current one).
+    pub outlook: MoveOutlook,
 }
 
 /// A force controller: force estimate in, twine motor speed out.
@@ -79,6 +105,12 @@ impl ForceController for Pid {
 pub enum ControllerConfig {
     /// `type = "pid"`: the paper's PID on the force error ([`PidConfig`]'s keys).
     Pid(PidConfig),
+    /// `type = "feedforward"`: the PID on a setpoint raised ahead of and during the arm's moves
+    /// ([`FeedforwardConfig`]'s keys, [`crate::control::feedforward`]).
+    Feedforward(FeedforwardConfig),
+    /// `type = "slip_margin"`: a grip kept a margin above the friction limit of the planned load
+    /// ([`SlipMarginConfig`]'s keys, [`crate::control::slip_margin`]).
+    SlipMargin(SlipMarginConfig),
 }
 
 impl Default for ControllerConfig {
@@ -89,19 +121,24 @@ impl Default for ControllerConfig {
 
 impl ControllerConfig {
     /// The known values of `type`.
-    pub const TYPES: &'static [&'static str] = &["pid"];
+    pub const TYPES: &'static [&'static str] = &["pid", "feedforward", "slip_margin"];
 
     /// The value of `type` for this configuration.
     pub fn type_name(&self) -> &'static str {
         match self {
             ControllerConfig::Pid(_) => "pid",
+            ControllerConfig::Feedforward(_) => "feedforward",
+            ControllerConfig::SlipMargin(_) => "slip_margin",
         }
     }
 
-    /// The PID's configuration, if this is one (summaries report its gains).
-    pub fn pid(&self) -> Option<&PidConfig> {
+    /// The configuration of the PID in this controller, if it has one (summaries report its
+    /// gains): the PID's own, and the feedback PID of `feedforward` and `slip_margin`.
+    pub fn pid(&self) -> Option<PidConfig> {
         match self {
-            ControllerConfig::Pid(c) => Some(c),
+            ControllerConfig::Pid(c) => Some(*c),
+            ControllerConfig::Feedforward(c) => Some(c.pid()),
+            ControllerConfig::SlipMargin(c) => Some(c.pid()),
         }
     }
 
@@ -109,6 +146,8 @@ impl ControllerConfig {
     pub fn build(&self) -> Box<dyn ForceController> {
         match self {
             ControllerConfig::Pid(c) => Box::new(Pid::new(*c)),
+            ControllerConfig::Feedforward(c) => Box::new(Feedforward::new(*c)),
+            ControllerConfig::SlipMargin(c) => Box::new(SlipMargin::new(*c)),
         }
     }
 }
@@ -118,6 +157,8 @@ impl Validate for ControllerConfig {
         // The variant's keys sit directly in `[controller]`, so no extra section level.
         match self {
             ControllerConfig::Pid(c) => c.validate(at),
+            ControllerConfig::Feedforward(c) => c.validate(at),
+            ControllerConfig::SlipMargin(c) => c.validate(at),
         }
     }
 }
@@ -141,6 +182,8 @@ impl<'de> Deserialize<'de> for ControllerConfig {
         };
         match kind.as_str() {
             "pid" => crate::scenario::deserialize_section(table).map(ControllerConfig::Pid),
+            "feedforward" => crate::scenario::deserialize_section(table).map(ControllerConfig::Feedforward),
+            "slip_margin" => crate::scenario::deserialize_section(table).map(ControllerConfig::SlipMargin),
             _ => Err(crate::scenario::section_error(
                 "type",
                 &format!("unknown controller type `{kind}`; known types: {}", known_types()),
@@ -223,6 +266,48 @@ mod tests {
     }
 
     #[test]
+    fn the_new_types_read_their_keys_and_refuse_others() {
+        let ff = load("type = \"feedforward\"\nmargin = 0.08\nlead_s = 3.0\nkp = 15.0").unwrap().controller;
+        let expected = FeedforwardConfig { margin: 0.08, lead_s: 3.0, kp: 15.0, ..FeedforwardConfig::default() };
+        assert_eq!(ff, ControllerConfig::Feedforward(expected));
+        assert_eq!(ff.type_name(), "feedforward");
+        assert_eq!(ff.pid().map(|p| p.kp), Some(15.0));
+        let sm = load("type = \"slip_margin\"\nmargin = 0.05\nlever_m = 0.5").unwrap().controller;
+        let expected = SlipMarginConfig { margin: 0.05, lever_m: 0.5, ..SlipMarginConfig::default() };
+        assert_eq!(sm, ControllerConfig::SlipMargin(expected));
+        assert_eq!(sm.type_name(), "slip_margin");
+        // Each type's keys only.
+        let (key, _) = refused_at("type = \"feedforward\"\nlever_m = 0.5");
+        assert_eq!(key, "controller.lever_m");
+        let (key, _) = refused_at("type = \"slip_margin\"\naccel_gain = 0.5");
+        assert_eq!(key, "controller.accel_gain");
+        let (key, _) = refused_at("lead_s = 1.0");
+        assert_eq!(key, "controller.lead_s");
+        let (_, reason) = refused_at("type = \"nope\"");
+        assert!(reason.contains("`feedforward`") && reason.contains("`slip_margin`"), "{reason}");
+    }
+
+    #[test]
+    fn the_new_types_refuse_out_of_range_values_by_key() {
+        for (text, key) in [
+            ("type = \"feedforward\"\nmargin = -0.1", "controller.margin"),
+            ("type = \"feedforward\"\nlead_s = 1e9", "controller.lead_s"),
+            ("type = \"feedforward\"\naccel_gain = nan", "controller.accel_gain"),
+            ("type = \"feedforward\"\nkp = -1.0", "controller.kp"),
+            ("type = \"slip_margin\"\nmargin = 2.0", "controller.margin"),
+            ("type = \"slip_margin\"\nstatic_margin = -1.0", "controller.static_margin"),
+            ("type = \"slip_margin\"\nlever_m = 5.0", "controller.lever_m"),
+            ("type = \"slip_margin\"\nforce_gain_n_per_deg = inf", "controller.force_gain_n_per_deg"),
+            ("type = \"slip_margin\"\nmax_speed_deg_s = 0.0", "controller.max_speed_deg_s"),
+            ("type = \"slip_margin\"\nmax_release_deg_s = -1.0", "controller.max_release_deg_s"),
+            ("type = \"feedforward\"\nmax_release_deg_s = 1000.0", "controller.max_release_deg_s"),
+        ] {
+            let (k, reason) = refused_at(text);
+            assert_eq!(k, key, "{text}: {reason}");
+        }
+    }
+
+    #[test]
     fn the_pid_behind_the_trait_is_the_pid() {
         let config = PidConfig { kp: 20.0, ki: 0.05, kd: 0.3, ..PidConfig::default() };
         let mut direct = Pid::new(config);
@@ -237,6 +322,7 @@ mod tests {
                 phase: Phase::Grasp,
                 blocked: i % 7 == 0,
                 arm: ArmMotion::default(),
+                outlook: MoveOutlook::default(),
             };
             assert_eq!(boxed.update(&ctx).to_bits(), direct.update(1.0, force_n, 0.01, ctx.blocked).to_bits());
         }

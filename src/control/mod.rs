@@ -7,14 +7,18 @@
 //! - [`task`]: the pick-and-place sequence.
 //! - [`controller`]: the force-controller seam ([`controller::ForceController`]) and `[controller]`.
 //! - [`pid`]: the paper's force controller, a PID (output: twine motor speed).
+//! - [`feedforward`]: the PID on a setpoint scheduled from the arm's planned motion.
+//! - [`slip_margin`]: a grip kept a margin above the friction limit of the planned load.
 //! - [`trajectory`]: joint-space moves within the paper's speed and acceleration limits.
 //! - [`slip`]: slip and loss detection from the force estimate.
 
 pub mod controller;
 pub mod estimate;
+pub mod feedforward;
 pub mod gripper;
 pub mod hysteresis;
 pub mod pid;
 pub mod slip;
+pub mod slip_margin;
 pub mod task;
 pub mod trajectory;

@@ -4,7 +4,7 @@
 //! Each tick the sequencer takes the cell's state and the force estimate and returns the
 //! command. It never sees the true force: control runs on the sensor, as on the real cell.
 
-use super::controller::{ArmMotion, ControlContext, ForceController};
+use super::controller::{ArmMotion, ControlContext, ForceController, MoveOutlook};
 use super::gripper::GripperConfig;
 use super::trajectory::{JointLimits, JointMove};
 use crate::hardware::{ARM_JOINTS, CellCommand, CellState};
@@ -111,6 +111,11 @@ pub struct TaskConfig {
     pub release_s: f64,
     /// Joint speed and acceleration limits during the moves.
     pub limits: JointLimits,
+    /// Whether the moves last at least `lift_s`, `transfer_s` and `lower_s` (default `true`: the
+    /// paper's timing). `false` plans every move time-optimal at `limits`, the paper's 45 °/s and
+    /// 15 °/s² by default: the arm then moves as hard as the limits allow, and the phase
+    /// durations are the moves' (a few seconds each) instead of the paper's drop times.
+    pub minimum_durations: bool,
 }
 
 impl Default for TaskConfig {
@@ -132,6 +137,7 @@ impl Default for TaskConfig {
             lower_s: 5.0,
             release_s: 2.0,
             limits: JointLimits::default(),
+            minimum_durations: true,
         }
     }
 }
@@ -224,6 +230,8 @@ pub struct TaskSequencer {
     growth_m: f64,
     motion_start_s: Option<f64>,
     unloaded_n: f64,
+    /// The lift, planned when the grasp starts (what the controller is told is ahead).
+    next_move: Option<JointMove>,
 }
 
 fn radians(deg: &[f64; ARM_JOINTS]) -> [f64; ARM_JOINTS] {
@@ -255,6 +263,7 @@ impl TaskSequencer {
             growth_m: 0.0,
             motion_start_s: None,
             unloaded_n: 0.0,
+            next_move: None,
         }
     }
 
@@ -282,14 +291,11 @@ impl TaskSequencer {
     fn enter(&mut self, phase: Phase, now: f64, arm_q: [f64; ARM_JOINTS]) {
         self.phase = phase;
         self.phase_start_s = now;
-        let t = &self.task;
-        let target = match phase {
-            Phase::Lift => Some((&t.lift_deg, t.lift_s)),
-            Phase::Transfer => Some((&t.transfer_deg, t.transfer_s)),
-            Phase::Lower => Some((&t.place_deg, t.lower_s)),
+        self.arm_move = self.plan_move(phase, arm_q);
+        self.next_move = match phase {
+            Phase::Grasp => self.plan_move(Phase::Lift, arm_q),
             _ => None,
         };
-        self.arm_move = target.map(|(pose, min_s)| JointMove::plan(arm_q, radians(pose), &t.limits, min_s));
         if phase == Phase::Lift {
             self.motion_start_s = Some(now);
             if !self.feedback_while_moving {
@@ -298,6 +304,33 @@ impl TaskSequencer {
         }
         if phase == Phase::Grasp {
             self.controller.reset();
+        }
+    }
+
+    /// The arm's move for `phase` (lift, transfer or lower) from `arm_q` \[rad\], if it has one.
+    fn plan_move(&self, phase: Phase, arm_q: [f64; ARM_JOINTS]) -> Option<JointMove> {
+        let t = &self.task;
+        let (pose, min_s) = match phase {
+            Phase::Lift => (&t.lift_deg, t.lift_s),
+            Phase::Transfer => (&t.transfer_deg, t.transfer_s),
+            Phase::Lower => (&t.place_deg, t.lower_s),
+            _ => return None,
+        };
+        let min_s = if t.minimum_durations { min_s } else { 0.0 };
+        Some(JointMove::plan(arm_q, radians(pose), &t.limits, min_s))
+    }
+
+    /// What lies ahead of the arm `elapsed` seconds into the current phase.
+    fn outlook(&self, elapsed: f64) -> MoveOutlook {
+        let (time_to_motion_s, plan) = match (self.phase, &self.arm_move, &self.next_move) {
+            (Phase::Grasp, _, Some(next)) => ((self.task.grasp_s - elapsed).max(0.0), next),
+            (p, Some(current), _) if p.arm_moving() => (0.0, current),
+            _ => return MoveOutlook::default(),
+        };
+        MoveOutlook {
+            time_to_motion_s,
+            peak_accel_rad_s2: plan.peak_accel_rad_s2(),
+            peak_speed_rad_s: plan.peak_speed_rad_s(),
         }
     }
 
@@ -364,8 +397,9 @@ impl TaskSequencer {
                 qd_rad_s: m.sample(elapsed).1,
                 qdd_rad_s2: m.acceleration(elapsed),
             });
+            let outlook = self.outlook(elapsed);
             let context =
-                ControlContext { setpoint_n: self.setpoint_n, force_n, dt_s, phase: self.phase, blocked, arm };
+                ControlContext { setpoint_n: self.setpoint_n, force_n, dt_s, phase: self.phase, blocked, arm, outlook };
             controller_output = self.controller.update(&context);
             self.twine_deg += controller_output * dt_s;
         }
@@ -393,7 +427,17 @@ mod tests {
     /// A toy plant: force grows linearly with twine past first contact at 60°, and relaxes by
     /// `creep_n_s` per second; returns (phases seen in order, final twine °, force trace).
     fn run_toy(feedback: bool, creep_n_s: f64) -> (Vec<Phase>, Vec<(f64, Phase, f64)>) {
-        let task = TaskConfig::default();
+        let (phases, trace, _) = run_toy_with(TaskConfig::default(), feedback, creep_n_s);
+        (phases, trace)
+    }
+
+    /// As [`run_toy`] with the task given; also returns the commanded arm joints per tick.
+    #[allow(clippy::type_complexity)]
+    fn run_toy_with(
+        task: TaskConfig,
+        feedback: bool,
+        creep_n_s: f64,
+    ) -> (Vec<Phase>, Vec<(f64, Phase, f64)>, Vec<[f64; ARM_JOINTS]>) {
         let gripper = GripperConfig::default();
         let mut seq = TaskSequencer::new(task, gripper, Box::new(Pid::new(PidConfig::default())), 1.0, feedback);
         let dt = 0.01;
@@ -402,6 +446,7 @@ mod tests {
         let mut phases = vec![];
         let mut trace = vec![];
         let mut arm_q = [0.0; ARM_JOINTS];
+        let mut arm = vec![];
         for i in 0..10_000 {
             let t = i as f64 * dt;
             let force = (0.02 * (twine_deg - 60.0) - offset).max(0.0);
@@ -419,6 +464,7 @@ mod tests {
             trace.push((t, d.phase, force));
             twine_deg = d.command.twine_motor_rad.to_degrees();
             arm_q = d.command.arm_q;
+            arm.push(arm_q);
             if force > 0.0 {
                 offset += creep_n_s * dt;
             }
@@ -426,7 +472,7 @@ mod tests {
                 break;
             }
         }
-        (phases, trace)
+        (phases, trace, arm)
     }
 
     #[test]
@@ -447,5 +493,60 @@ mod tests {
         // the ramp-following error of an integrating loop: 0.05 N/s / (Kp 20 × 0.02 N/°) = 0.125 N.
         assert!(last_moving(&without) < 0.3, "{}", last_moving(&without));
         assert!((last_moving(&with) - 0.875).abs() < 0.05, "{}", last_moving(&with));
+    }
+
+    #[test]
+    fn without_minimum_durations_the_moves_are_planned_at_the_limits() {
+        let duration = |trace: &[(f64, Phase, f64)], phase: Phase| {
+            let times: Vec<f64> = trace.iter().filter(|(_, p, _)| *p == phase).map(|(t, _, _)| *t).collect();
+            times.last().unwrap() - times.first().unwrap()
+        };
+        let (_, stretched, _) = run_toy_with(TaskConfig::default(), true, 0.0);
+        let fast_task = TaskConfig { minimum_durations: false, ..TaskConfig::default() };
+        let (phases, fast, arm) = run_toy_with(fast_task, true, 0.0);
+        assert!(phases.contains(&Phase::Done));
+        // The lift's largest joint travel is 20° (wrist): 2 √(20/15) = 2.31 s against the 11 s minimum.
+        let lift = duration(&fast, Phase::Lift);
+        assert!((lift - 2.31).abs() < 0.02 && duration(&stretched, Phase::Lift) > 10.9, "lift {lift} s");
+        // The commanded joints reach the 15 °/s² limit (second differences of the commands).
+        let dt = 0.01;
+        let peak = arm
+            .windows(3)
+            .flat_map(|w| (0..ARM_JOINTS).map(move |j| ((w[2][j] - 2.0 * w[1][j] + w[0][j]) / (dt * dt)).abs()))
+            .fold(0.0, f64::max)
+            .to_degrees();
+        assert!((peak - 15.0).abs() < 0.5, "peak joint acceleration {peak} °/s²");
+    }
+
+    #[test]
+    fn the_controller_is_told_the_lift_ahead() {
+        #[derive(Debug)]
+        struct Spy(std::sync::Arc<std::sync::Mutex<Vec<(Phase, MoveOutlook)>>>);
+        impl ForceController for Spy {
+            fn update(&mut self, ctx: &ControlContext) -> f64 {
+                self.0.lock().unwrap().push((ctx.phase, ctx.outlook));
+                0.0
+            }
+            fn reset(&mut self) {}
+            fn max_speed_deg_s(&self) -> f64 {
+                90.0
+            }
+        }
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(vec![]));
+        let task = TaskConfig { minimum_durations: false, ..TaskConfig::default() };
+        let mut seq = TaskSequencer::new(task, GripperConfig::default(), Box::new(Spy(seen.clone())), 1.0, true);
+        seq.enter(Phase::Grasp, 0.0, radians(&TaskConfig::default().home_deg));
+        let state = CellState {
+            time_s: 5.0,
+            arm_q: [0.0; ARM_JOINTS],
+            growth_motor_rad: 0.0,
+            twine_motor_rad: 0.0,
+            wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+        };
+        seq.update(&state, 0.5, 0.01);
+        let (phase, outlook) = seen.lock().unwrap()[0];
+        assert_eq!(phase, Phase::Grasp);
+        assert!((outlook.time_to_motion_s - 10.0).abs() < 1e-9, "{outlook:?}");
+        assert!((outlook.peak_accel_rad_s2.to_degrees() - 15.0).abs() < 1e-9, "{outlook:?}");
     }
 }

@@ -90,6 +90,21 @@ impl JointMove {
         self.to
     }
 
+    /// Largest planned joint speed over the move and the joints [rad/s].
+    pub fn peak_speed_rad_s(&self) -> f64 {
+        self.peak_rate * self.span_rad()
+    }
+
+    /// Largest planned joint acceleration over the move and the joints [rad/s²].
+    pub fn peak_accel_rad_s2(&self) -> f64 {
+        if self.ramp_s > 0.0 { self.peak_rate / self.ramp_s * self.span_rad() } else { 0.0 }
+    }
+
+    /// Largest joint travel \[rad\].
+    fn span_rad(&self) -> f64 {
+        self.from.iter().zip(&self.to).map(|(a, b)| (b - a).abs()).fold(0.0, f64::max)
+    }
+
     /// Path parameter s ∈ [0, 1] and its rate at time `t` after the start.
     fn progress(&self, t: f64) -> (f64, f64) {
         if self.peak_rate == 0.0 {
@@ -184,6 +199,19 @@ mod tests {
         // Joints stay synchronised: the second joint is always at minus half the first.
         let (q, _) = slow.sample(3.3);
         assert!((q[2] + 0.5 * q[1]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn peaks_are_those_of_the_profile() {
+        let to = [0.0, 20.0 * DEG, -10.0 * DEG, 0.0, 0.0, 0.0];
+        let fast = JointMove::plan([0.0; 6], to, &JointLimits::default(), 0.0);
+        let (v, a) = peak_speed_and_accel(&fast);
+        assert!((fast.peak_accel_rad_s2() / DEG - 15.0).abs() < 1e-9, "{}", fast.peak_accel_rad_s2() / DEG);
+        assert!((fast.peak_speed_rad_s() / DEG - v).abs() < 0.05 && a <= 15.1);
+        let slow = JointMove::plan([0.0; 6], to, &JointLimits::default(), 10.0);
+        assert!((slow.peak_accel_rad_s2() / DEG - 0.9).abs() < 1e-9);
+        assert!((slow.peak_speed_rad_s() / DEG - 3.0).abs() < 1e-9);
+        assert_eq!(JointMove::plan([0.0; 6], [0.0; 6], &JointLimits::default(), 1.0).peak_accel_rad_s2(), 0.0);
     }
 
     #[test]

@@ -16,6 +16,8 @@ pub fn run_on_real(
     config: RealCellConfig,
     out: Option<&Path>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
+    // Disturbances are the twin's: refuse before any device is contacted.
+    scenario.disturbance.refuse_on_real().map_err(|e| anyhow::anyhow!("{e}"))?;
     let started = std::time::Instant::now();
     let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator);
     let mut cell = LimitedCell::new(RealCell::new(config), limits);

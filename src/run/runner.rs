@@ -75,6 +75,9 @@ pub struct RunReport {
     pub error: Option<String>,
     /// Sensor samples skipped because they gave no estimate (the last valid one was held).
     pub invalid_samples: u64,
+    /// Control ticks without a new interrogator sample ([`Cell::sample_is_new`]): the last
+    /// estimate was held. They do not count as invalid samples.
+    pub dropped_samples: u64,
     /// Every tick, as written to the trace.
     pub rows: Vec<TraceRow>,
 }
@@ -109,6 +112,8 @@ pub fn run_task_with_controller(
     let mut slip = SlipDetector::new(plan.slip);
     let mut drop_watch = DropWatch::default();
     let mut truth_drop: Option<Drop> = None;
+    let mut dropped_samples = 0u64;
+    let mut last_phase: Option<Phase> = None;
     let dt = 1.0 / plan.rate_hz;
 
     let mut run = || -> Result<(), CellError> {
@@ -124,7 +129,14 @@ pub fn run_task_with_controller(
                 return Err(CellError::Stopped { signal: crate::interrupt::name(signal), time_s: tick as f64 * dt });
             }
             let state = cell.read()?;
-            if sequencer.phase() == Phase::Home {
+            // No new sample (an interrogator gap): hold the last estimate, as for an invalid
+            // sample, but without counting towards the consecutive-invalid limit (see
+            // `crate::cell::disturbance::DropoutConfig`).
+            let held = match invalid.last_valid {
+                Some(e) if !cell.sample_is_new() => Some(e),
+                _ => None,
+            };
+            if held.is_none() && sequencer.phase() == Phase::Home {
                 // Tare on the mean of the samples at home, finger retracted and untouched (a
                 // non-finite sample is left out: it would poison the mean for the whole run).
                 if state.wavelengths.fbg1_nm.is_finite() && state.wavelengths.fbg2_nm.is_finite() {
@@ -135,11 +147,21 @@ pub fn run_task_with_controller(
                 unloaded_n = estimator.estimate(mean).map_or(0.0, |e| e.force_n);
                 sequencer.set_unloaded_reading(unloaded_n);
             }
-            let estimate = invalid.check(estimator.track(state.wavelengths)).map_err(|cause| CellError::Device {
-                device: "estimator".into(),
-                cause: format!("at t = {:.3} s: {cause}", state.time_s),
-            })?;
+            let estimate = match held {
+                Some(e) => {
+                    dropped_samples += 1;
+                    e
+                }
+                None => invalid.check(estimator.track(state.wavelengths)).map_err(|cause| CellError::Device {
+                    device: "estimator".into(),
+                    cause: format!("at t = {:.3} s: {cause}", state.time_s),
+                })?,
+            };
             let decision = sequencer.update(&state, estimate.force_n, dt);
+            if last_phase != Some(decision.phase) {
+                cell.phase_started(decision.phase, state.time_s);
+                last_phase = Some(decision.phase);
+            }
             // Slip is watched while the arm carries the object, as in the paper.
             slip.update(state.time_s, estimate.force_n, unloaded_n, plan.setpoint_n, decision.phase.arm_moving());
             cell.write(&decision.command)?;
@@ -204,6 +226,7 @@ pub fn run_task_with_controller(
         cell_time_s: rows.last().map_or(0.0, |r| r.time_s),
         error,
         invalid_samples: invalid.total,
+        dropped_samples,
         rows,
     }
 }

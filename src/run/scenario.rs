@@ -10,6 +10,7 @@
 
 use super::runner::ControlPlan;
 use super::summary::{Gains, RunIdentity};
+use crate::cell::disturbance::DisturbanceConfig;
 use crate::cell::fbg::{InterrogatorConfig, SensorConfig};
 use crate::cell::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneSpec};
 use crate::cell::real::HardwareConfig;
@@ -81,6 +82,9 @@ pub struct PickPlaceScenario {
     /// `tendril serve`.
     #[serde(default)]
     pub hardware: HardwareConfig,
+    /// Disturbances on the twin (a push on the object, a sensor dropout); none by default.
+    #[serde(default)]
+    pub disturbance: DisturbanceConfig,
 }
 
 fn default_seed() -> u64 {
@@ -111,6 +115,17 @@ impl Validate for PickPlaceScenario {
         at.section("physics", &self.physics);
         at.section("finger", &self.finger);
         at.section("hardware", &self.hardware);
+        at.section("disturbance", &self.disturbance);
+        at.require(
+            "disturbance.push",
+            self.disturbance.push.is_none() || self.physics.backend == crate::cell::physics::Backend::Mujoco,
+            || {
+                format!(
+                    "the {} backend does not apply pushes; use physics.backend = \"mujoco\"",
+                    self.physics.backend.name()
+                )
+            },
+        );
         // Above the sensor's range the reading saturates (4.69 N, paper Sec. IV-B).
         at.require("setpoint_n", self.setpoint_n > 0.0 && self.setpoint_n < self.estimator.range_n, || {
             format!("must be > 0 and below the sensor's range {} N, got {}", self.estimator.range_n, self.setpoint_n)

@@ -73,6 +73,10 @@ pub struct RunSummary {
     /// [`crate::run::runner::MAX_CONSECUTIVE_INVALID_SAMPLES`]).
     #[serde(default)]
     pub invalid_samples: u64,
+    /// Control ticks that got no new interrogator sample (a `[disturbance.dropout]`): the last
+    /// estimate was held. Not invalid samples: they do not count towards the consecutive limit.
+    #[serde(default)]
+    pub dropped_samples: u64,
     /// MuJoCo's warnings during the run (see [`crate::mujoco_log`]), at most
     /// [`crate::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
     #[serde(default)]
@@ -117,6 +121,7 @@ impl RunSummary {
             real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },
             error: report.error.clone(),
             invalid_samples: report.invalid_samples,
+            dropped_samples: report.dropped_samples,
             warnings: Vec::new(),
         }
     }
@@ -146,6 +151,9 @@ pub fn render_text(s: &RunSummary) -> String {
     out += "\n";
     if let Some(e) = &s.error {
         out += &format!("  error              {e}\n");
+    }
+    if s.dropped_samples > 0 {
+        out += &format!("  dropped samples    {} ticks without a new sample (estimate held)\n", s.dropped_samples);
     }
     if s.invalid_samples > 0 {
         out += &format!("  invalid samples    {} skipped (last valid estimate held)\n", s.invalid_samples);

@@ -55,6 +55,19 @@ pub trait Physics: Send {
     fn step(&mut self) -> Result<(), PhysicsError>;
     /// The readout after the last step.
     fn readout(&self) -> PhysicsReadout;
+    /// Applies `force_n` \[N\] (world frame) at the object's centre of mass during the following
+    /// steps, until set again (zero to stop): the twin's `[disturbance.push]`. Engines that cannot
+    /// refuse with [`PhysicsError::Config`] on `disturbance.push`.
+    fn set_object_force(&mut self, force_n: [f64; 3]) -> Result<(), PhysicsError> {
+        let _ = force_n;
+        Err(PhysicsError::Config {
+            key: "disturbance.push".into(),
+            reason: format!(
+                "the {} backend does not apply pushes; use physics.backend = \"mujoco\"",
+                self.backend().name()
+            ),
+        })
+    }
 
     /// Steps for `seconds` of simulated time (rounded to whole steps).
     fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {

@@ -443,6 +443,21 @@ impl Physics for Scene {
         self.check(t0 + dt)
     }
 
+    fn set_object_force(&mut self, force_n: [f64; 3]) -> Result<(), PhysicsError> {
+        let Some(body) = self.shared.ids.object_body else {
+            return Err(PhysicsError::Config {
+                key: "disturbance.push".into(),
+                reason: "the scene has no object to push".into(),
+            });
+        };
+        if let Some(bad) = force_n.iter().find(|f| !f.is_finite()) {
+            return Err(PhysicsError::BadInput { what: "object push force", value: *bad });
+        }
+        // xfrc_applied: a Cartesian force and torque at the body's centre of mass, world frame.
+        self.data.xfrc_applied_mut()[body] = [force_n[0], force_n[1], force_n[2], 0.0, 0.0, 0.0];
+        Ok(())
+    }
+
     fn readout(&self) -> PhysicsReadout {
         let ids = &self.shared.ids;
         let qpos = self.data.qpos();
