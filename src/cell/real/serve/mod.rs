@@ -16,6 +16,8 @@
 //! Nothing here panics on input.
 
 mod net;
+pub mod pose;
+pub mod safety;
 mod twin;
 
 use crate::cell::real::HardwareConfig;
@@ -27,7 +29,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-pub use twin::{DeviceState, TwinStatus};
+pub use twin::{DeviceState, ProgramState, TwinStatus};
 
 /// Where the virtual devices listen and how fast the twin runs.
 #[derive(Debug, Clone, PartialEq)]
