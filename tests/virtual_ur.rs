@@ -186,7 +186,9 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
     assert!(serve.running());
     serve.stop().unwrap();
 
-    let parsed: Vec<(f64, [f64; 6], [f64; 6], [f64; 6], [f64; 6], [f64; 6])> =
+    /// timestamp, actual_q, actual_qd, actual_TCP_pose, target_TCP_pose, target_q.
+    type Sample = (f64, [f64; 6], [f64; 6], [f64; 6], [f64; 6], [f64; 6]);
+    let parsed: Vec<Sample> =
         samples.iter().map(|s| (f(&s[0]), v6(&s[1]), v6(&s[2]), v6(&s[3]), v6(&s[4]), v6(&s[5]))).collect();
     // The pose is the forward kinematics of the joint angles of the same sample, target likewise.
     for (_, q, _, pose, target_pose, target_q) in &parsed {
