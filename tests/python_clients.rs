@@ -55,7 +55,19 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
         assert!((a - b).abs() < 1e-3, "ur_rtde q {q:?}, twin {:?}", twin.arm_q);
     }
     assert!((q[0] + std::f64::consts::FRAC_PI_2).abs() < 1e-2, "home base joint is -90°: {q:?}");
+    // The TCP pose is the forward kinematics of the same sample's joints (it was all zeros), and
+    // the arm stands still.
+    let q6: [f64; 6] = std::array::from_fn(|j| q[j]);
+    let pose: Vec<f64> = serde_json::from_value(v["pose"].clone()).unwrap();
+    let expected = tendril::cell::real::serve::pose::tcp_pose(&q6, &[0.0; 6]);
+    for (a, b) in pose.iter().zip(expected) {
+        assert!((a - b).abs() < 1e-9, "ur_rtde pose {pose:?}, fk(q) {expected:?}");
+    }
+    assert!(pose[2] > 0.1, "{pose:?}");
+    let qd: Vec<f64> = serde_json::from_value(v["qd"].clone()).unwrap();
+    assert!(qd.iter().all(|v| v.abs() < 1e-6), "standing still: {qd:?}");
     assert_eq!(v["robot_mode"], 7);
+    assert_eq!(v["safety_mode"], 1);
     assert!(v["t"].as_f64().unwrap() > 0.0);
 }
 

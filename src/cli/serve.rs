@@ -1,7 +1,7 @@
 //! `tendril serve`: the twin behind the real devices' protocols.
 
 use super::emit;
-use crate::cell::real::serve::{ServeConfig, start};
+use crate::cell::real::serve::{ProgramState, ServeConfig, start};
 use crate::run::scenario::PickPlaceScenario;
 use crate::scenario::Override;
 use std::net::IpAddr;
@@ -54,9 +54,21 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     // Ctrl-C, SIGTERM and SIGHUP alike: the devices are shut down and the status reported.
     crate::interrupt::install()?;
     let started = std::time::Instant::now();
+    // What the virtual UR5e's program and safety system last did, to report their changes.
+    let mut reported = (ProgramState::Stopped, None::<String>);
     while crate::interrupt::requested().is_none() && handle.running() {
         if a.seconds.is_some_and(|s| started.elapsed().as_secs_f64() >= s) {
             break;
+        }
+        let now = handle.state.lock().map(|s| (s.program, s.protective_stop.clone())).unwrap_or(reported.clone());
+        if now != reported {
+            if let Some(why) = now.1.as_ref().filter(|_| now.1 != reported.1) {
+                emit(&format!("UR5e protective stop: {why} (upload the program again to clear it)\n"));
+            }
+            if now.0 != reported.0 {
+                emit(&format!("UR5e program: {:?}\n", now.0));
+            }
+            reported = now;
         }
         std::thread::sleep(Duration::from_millis(50));
     }

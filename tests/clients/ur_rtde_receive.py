@@ -1,4 +1,5 @@
-"""SDU ur_rtde's RTDEReceiveInterface against the virtual UR5e: prints actual_q and the timestamp as JSON.
+"""SDU ur_rtde's RTDEReceiveInterface against the virtual UR5e: prints actual_q, actual_qd,
+actual_TCP_pose, the safety mode and the timestamp as JSON.
 
 Usage: python ur_rtde_receive.py HOST   (ur_rtde always uses port 30004)
 """
@@ -8,8 +9,17 @@ import time
 
 import rtde_receive
 
-r = rtde_receive.RTDEReceiveInterface(sys.argv[1], 500.0, ["timestamp", "actual_q", "robot_mode"])
+names = ["timestamp", "actual_q", "actual_qd", "actual_TCP_pose", "robot_mode", "safety_mode"]
+r = rtde_receive.RTDEReceiveInterface(sys.argv[1], 500.0, names)
 time.sleep(0.3)
-out = {"q": r.getActualQ(), "t": r.getTimestamp(), "robot_mode": r.getRobotMode(), "connected": r.isConnected()}
+out = {
+    "q": r.getActualQ(),
+    "qd": r.getActualQd(),
+    "pose": r.getActualTCPPose(),
+    "t": r.getTimestamp(),
+    "robot_mode": r.getRobotMode(),
+    "safety_mode": r.getSafetyMode(),
+    "connected": r.isConnected(),
+}
 r.disconnect()
 print(json.dumps(out))

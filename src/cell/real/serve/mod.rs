@@ -3,7 +3,10 @@
 //! - RTDE on `rtde_port` (30004) and the URScript secondary interface on `script_port` (30002): the
 //!   virtual controller "runs" an uploaded program by doing what `follow.script` does (follow
 //!   `input_double_register_24..29` while `input_int_register_24` = 1, else hold); see
-//!   [`crate::cell::real::urscript`].
+//!   [`crate::cell::real::urscript`]. The program's `rtde_set_watchdog` call is honoured (the
+//!   program stops or pauses when the watched input is not written in time); targets beyond the
+//!   UR5e's joint range or speed, or non-finite, put the arm in a protective stop ([`safety`])
+//!   until a fresh program upload. `actual_TCP_pose` and `target_TCP_pose` come from [`pose`].
 //! - Dynamixel: two MX-106 at the scenario's `hardware.growth_id` and `hardware.twine_id` (1, 2 by
 //!   default) on a pseudo-terminal (its path in [`ServeHandle::pty_path`]); Goal Position drives
 //!   the twin's motors, Present Position reports them; Baud Rate reads `hardware.dxl_baud`.
@@ -16,6 +19,8 @@
 //! Nothing here panics on input.
 
 mod net;
+pub mod pose;
+pub mod safety;
 mod twin;
 
 use crate::cell::real::HardwareConfig;
@@ -27,7 +32,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-pub use twin::{DeviceState, TwinStatus};
+pub use twin::{DeviceState, ProgramState, TwinStatus};
 
 /// Where the virtual devices listen and how fast the twin runs.
 #[derive(Debug, Clone, PartialEq)]

@@ -2,8 +2,9 @@
 
 use super::ServeConfig;
 use super::twin::DeviceState;
+use super::twin::ProgramState;
 use crate::cell::real::protocol::rtde::{ServerConfig, ServerSession};
-use crate::cell::real::urscript::is_complete_program;
+use crate::cell::real::urscript::{find_watchdog, is_complete_program};
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -141,8 +142,27 @@ async fn serve_script(mut socket: TcpStream, state: Shared) {
             break;
         }
     }
-    if std::str::from_utf8(&text).is_ok_and(is_complete_program) {
-        lock(&state).program_loaded = true;
+    let Ok(program) = std::str::from_utf8(&text) else { return };
+    if !is_complete_program(program) {
+        return;
+    }
+    // A program whose watchdog call is malformed fails at that line on a real controller: it
+    // does not run (and the one before it has been replaced).
+    let watchdog = find_watchdog(program);
+    let mut s = lock(&state);
+    s.program_uploads += 1;
+    // A fresh upload also clears a protective stop (see `safety`): the virtual UR has no
+    // dashboard server to unlock it with.
+    s.protective_stop = None;
+    match watchdog {
+        Ok(w) => {
+            s.watchdog = w;
+            s.program = ProgramState::Playing;
+        }
+        Err(_) => {
+            s.watchdog = None;
+            s.program = ProgramState::Stopped;
+        }
     }
 }
 

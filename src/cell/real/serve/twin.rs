@@ -1,15 +1,18 @@
 //! The twin thread (SimCell in real time) and the Dynamixel bus on a pseudo-terminal.
 
+use super::pose::tcp_pose;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
 use crate::cell::real::protocol::dynamixel::units::{baud_rate_code, rad_to_ticks, ticks_to_rad};
 use crate::cell::real::protocol::dynamixel::{StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
-use crate::cell::real::protocol::rtde::state::RUNTIME_STATE_PLAYING;
+use crate::cell::real::protocol::rtde::state::{
+    RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
+};
 use crate::cell::real::protocol::rtde::{RobotOutputs, SharedInputs};
 use crate::cell::real::realtime::RealtimeOptions;
-use crate::cell::real::urscript::{ENABLE_REGISTER, FOLLOWING_REGISTER, TARGET_REGISTER};
+use crate::cell::real::urscript::{ENABLE_REGISTER, FOLLOWING_REGISTER, RtdeWatchdog, TARGET_REGISTER, WatchdogAction};
 use crate::cell::sim::SimCell;
 use crate::hardware::{ARM_JOINTS, Cell, CellCommand, GroundTruth};
 use crate::run::scenario::PickPlaceScenario;
@@ -49,14 +52,33 @@ impl Default for TwinStatus {
     }
 }
 
+/// The uploaded program's state, as `runtime_state` reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProgramState {
+    /// No program, or it was stopped (by its RTDE watchdog or a protective stop): STOPPED (1).
+    Stopped,
+    /// Running: PLAYING (2).
+    Playing,
+    /// Paused by its RTDE watchdog (action "pause"): PAUSED (4).
+    Paused,
+}
+
 /// Everything the protocol servers and the twin share.
 pub struct DeviceState {
     /// What the virtual UR5e reports.
     pub outputs: RobotOutputs,
     /// What RTDE clients wrote.
     pub inputs: SharedInputs,
-    /// Whether a complete program came in on the secondary interface.
-    pub program_loaded: bool,
+    /// The program that came in on the secondary interface: it plays from its upload until its
+    /// RTDE watchdog or a protective stop stops it.
+    pub program: ProgramState,
+    /// The program's `rtde_set_watchdog` call, if it has one.
+    pub watchdog: Option<RtdeWatchdog>,
+    /// Programs uploaded so far (each upload restarts the program and its watchdog).
+    pub program_uploads: u64,
+    /// Why the arm is in a protective stop, if it is (cleared by a fresh program upload: the
+    /// virtual UR has no dashboard server to unlock it with).
+    pub protective_stop: Option<String>,
     /// The MX-106 pair.
     pub bus: VirtualBus,
     /// The interrogator.
@@ -88,7 +110,10 @@ pub fn shared_state(
     let state = DeviceState {
         outputs: RobotOutputs::default(),
         inputs: SharedInputs::new(),
-        program_loaded: false,
+        program: ProgramState::Stopped,
+        watchdog: None,
+        program_uploads: 0,
+        protective_stop: None,
         bus,
         interrogator,
         status: TwinStatus::default(),
@@ -160,7 +185,16 @@ pub fn spawn(
             growth_motor_rad: first.growth_motor_rad,
             twine_motor_rad: first.twine_motor_rad,
         };
-        let mut previous_q = first.arm_q;
+        // The physics moves the arm once per step (several twin ticks): the joint velocities are
+        // the last step's displacement over its duration (the kinematic arm moves at a constant
+        // rate within a step), held until the next step changes them.
+        let mut last_step = (first.time_s, first.arm_q);
+        let mut actual_qd = [0.0; ARM_JOINTS];
+        let mut measured_q = first.arm_q;
+        // The program's RTDE watchdog once armed: the watched input's write count and when it last
+        // changed (twin time, so a twin held up by a lock never counts as a silent client).
+        let mut watchdog: Option<(u64, f64)> = None;
+        let mut uploads_seen = 0;
         {
             let mut s = lock(&state);
             for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
@@ -172,6 +206,8 @@ pub fn spawn(
             }
             s.outputs.actual_q = first.arm_q;
             s.outputs.target_q = first.arm_q;
+            s.outputs.actual_tcp_pose = tcp_pose(&first.arm_q, &s.outputs.tcp_offset);
+            s.outputs.target_tcp_pose = s.outputs.actual_tcp_pose;
         }
         let mut packages_seen = 0;
         let started = Instant::now();
@@ -179,18 +215,63 @@ pub fn spawn(
             if stop.load(Ordering::SeqCst) {
                 return Ok(());
             }
+            let now_s = (k - 1) as f64 * period_s;
             let new_arm_target = {
-                let s = lock(&state);
-                let regs = &s.inputs.values;
-                let following = s.program_loaded && regs.int_registers[ENABLE_REGISTER] == 1;
-                let targets: [f64; ARM_JOINTS] = std::array::from_fn(|j| regs.double_registers[TARGET_REGISTER + j]);
+                let mut s = lock(&state);
+                if s.program_uploads != uploads_seen {
+                    uploads_seen = s.program_uploads;
+                    watchdog = None;
+                }
+                let enabled = s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
+                let targets: [f64; ARM_JOINTS] =
+                    std::array::from_fn(|j| s.inputs.values.double_registers[TARGET_REGISTER + j]);
                 // A target is new when a package came in: the arm then moves to it over the time
                 // since the one before, the client's cadence, as the simulated path's arm does.
                 let arrived = s.inputs.packages != packages_seen;
                 packages_seen = s.inputs.packages;
-                let new = following && arrived && targets.iter().all(|v| v.is_finite());
-                if new {
-                    command.arm_q = targets;
+                let mut hold = false;
+                // rtde_set_watchdog, as our program calls it: armed at the first enabled tick.
+                let watched =
+                    s.watchdog.as_ref().map(|w| (s.inputs.writes_of(&w.variable), w.min_frequency_hz, w.action));
+                if s.program == ProgramState::Playing
+                    && let Some((writes, min_hz, action)) = watched
+                {
+                    match &mut watchdog {
+                        None if enabled => watchdog = Some((writes, now_s)),
+                        None => {}
+                        Some((seen, at)) if *seen != writes => (*seen, *at) = (writes, now_s),
+                        Some((_, at)) if now_s - *at > 1.0 / min_hz => match action {
+                            WatchdogAction::Ignore => {}
+                            WatchdogAction::Pause | WatchdogAction::Stop => {
+                                s.program = if action == WatchdogAction::Stop {
+                                    ProgramState::Stopped
+                                } else {
+                                    ProgramState::Paused
+                                };
+                                hold = true;
+                            }
+                        },
+                        Some(_) => {}
+                    }
+                }
+                let mut new = false;
+                if s.program == ProgramState::Playing && enabled && arrived {
+                    match super::safety::violation(&targets, &measured_q) {
+                        None => {
+                            command.arm_q = targets;
+                            new = true;
+                        }
+                        Some(why) => {
+                            // Protective stop: the arm stops where it is, the program stops.
+                            s.protective_stop = Some(why);
+                            s.program = ProgramState::Stopped;
+                            hold = true;
+                        }
+                    }
+                }
+                if hold {
+                    command.arm_q = measured_q;
+                    new = true;
                 }
                 for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
                 {
@@ -210,19 +291,33 @@ pub fn spawn(
             cell.wait_until(k as f64 * period_s).map_err(e)?;
             let r = cell.read().map_err(e)?;
             let truth = cell.ground_truth().unwrap_or_default();
+            if r.time_s > last_step.0 + 1e-12 {
+                let dt = r.time_s - last_step.0;
+                actual_qd = std::array::from_fn(|j| (r.arm_q[j] - last_step.1[j]) / dt);
+                last_step = (r.time_s, r.arm_q);
+            }
+            measured_q = r.arm_q;
             {
                 let mut s = lock(&state);
-                let following = s.program_loaded && s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
-                // The uploaded program runs forever once loaded: PLAYING (2), else STOPPED (1).
-                let runtime_state = if s.program_loaded { RUNTIME_STATE_PLAYING } else { 1 };
+                let following =
+                    s.program == ProgramState::Playing && s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
+                let runtime_state = match s.program {
+                    ProgramState::Stopped => RUNTIME_STATE_STOPPED,
+                    ProgramState::Playing => RUNTIME_STATE_PLAYING,
+                    ProgramState::Paused => RUNTIME_STATE_PAUSED,
+                };
+                let safety_mode =
+                    if s.protective_stop.is_some() { SAFETY_MODE_PROTECTIVE_STOP } else { SAFETY_MODE_NORMAL };
                 let o = &mut s.outputs;
                 o.runtime_state = runtime_state;
+                o.safety_mode = safety_mode;
                 o.timestamp_s = r.time_s;
-                o.actual_qd = std::array::from_fn(|j| (r.arm_q[j] - previous_q[j]) / period_s);
+                o.actual_qd = actual_qd;
                 o.actual_q = r.arm_q;
                 o.target_q = command.arm_q;
+                o.actual_tcp_pose = tcp_pose(&r.arm_q, &o.tcp_offset);
+                o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
                 o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
-                previous_q = r.arm_q;
                 for (id, rad) in motors.into_iter().zip([r.growth_motor_rad, r.twine_motor_rad]) {
                     if let (Some(t), Ok(ticks)) = (s.bus.table_mut(id), rad_to_ticks(rad)) {
                         t.set_present_position(ticks);

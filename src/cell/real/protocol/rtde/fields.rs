@@ -7,6 +7,8 @@
 //! names are served with their type's zero (or a fixed plausible value, see `server.rs`), so
 //! clients that ask for everything (ur_rtde's 58 default names) still get a valid recipe.
 
+#[cfg(doc)]
+use super::state::RobotOutputs;
 use super::types::RtdeType;
 use super::types::RtdeType::*;
 
@@ -88,6 +90,16 @@ pub const FIXED_OUTPUTS: &[(&str, RtdeType)] = &[
     ("ft_raw_wrench", Vector6d),
     ("joint_position_deviation_ratio", Double),
     ("collision_detection_ratio", Double),
+    // Added after SDU ur_rtde's `RTDEReceiveInterface` with all variables hit "Unknown data
+    // type: NOT_FOUND" on them. Types as in UR's RTDE guide output table (cross-checked against
+    // the type table of the fake RTDE server in UR's own `ur_client_library` tests). Values:
+    // `tcp_offset` is the configured TCP offset ([`RobotOutputs::tcp_offset`], zeros: we set none);
+    // the configurable digital IO bits are 0 (nothing wired) and both encoders read 0 (none fitted).
+    ("tcp_offset", Vector6d),
+    ("actual_configurable_digital_input_bits", Uint64),
+    ("actual_configurable_digital_output_bits", Uint64),
+    ("encoder0_raw", Int32),
+    ("encoder1_raw", Int32),
 ];
 
 /// Input fields with a fixed name.
@@ -121,6 +133,7 @@ pub const TWIN_OUTPUTS: &[&str] = &[
     "actual_TCP_speed",
     "actual_TCP_force",
     "target_TCP_pose",
+    "tcp_offset",
     "robot_mode",
     "safety_mode",
     "runtime_state",
@@ -274,6 +287,15 @@ mod tests {
         assert_eq!(input_type("output_int_register_0"), None);
         assert_eq!(input_type("actual_q"), None);
         assert_eq!(output_type("no_such_field"), None);
+    }
+
+    #[test]
+    fn names_once_answered_not_found_have_urs_types() {
+        assert_eq!(output_type("tcp_offset"), Some(Vector6d));
+        assert_eq!(output_type("actual_configurable_digital_input_bits"), Some(Uint64));
+        assert_eq!(output_type("actual_configurable_digital_output_bits"), Some(Uint64));
+        assert_eq!(output_type("encoder0_raw"), Some(Int32));
+        assert_eq!(output_type("encoder1_raw"), Some(Int32));
     }
 
     #[test]

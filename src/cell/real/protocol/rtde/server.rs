@@ -52,12 +52,18 @@ pub struct SharedInputs {
     /// streams its targets.
     pub packages: u64,
     owners: HashMap<String, u64>,
+    writes: HashMap<String, u64>,
 }
 
 impl SharedInputs {
     /// Empty inputs, nothing claimed.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// How many input data packages wrote `name` so far (what `rtde_set_watchdog` watches).
+    pub fn writes_of(&self, name: &str) -> u64 {
+        self.writes.get(name).copied().unwrap_or(0)
     }
 
     /// Frees the inputs claimed by a closed connection.
@@ -233,6 +239,12 @@ impl ServerSession {
         let values = recipe.decode(data)?;
         for (name, value) in recipe.names.iter().zip(values) {
             shared.values.apply(name, value);
+            match shared.writes.get_mut(name) {
+                Some(n) => *n += 1,
+                None => {
+                    shared.writes.insert(name.clone(), 1);
+                }
+            }
         }
         shared.packages += 1;
         Ok(())

@@ -9,8 +9,14 @@ use super::types::{RtdeType, RtdeValue};
 pub const ROBOT_MODE_RUNNING: i32 = 7;
 /// `safety_mode` value for normal operation (SAFETY_MODE_NORMAL).
 pub const SAFETY_MODE_NORMAL: i32 = 1;
+/// `safety_mode` and `safety_status` value in a protective stop (SAFETY_MODE_PROTECTIVE_STOP).
+pub const SAFETY_MODE_PROTECTIVE_STOP: i32 = 3;
 /// `runtime_state` value while a program plays (PLAYING).
 pub const RUNTIME_STATE_PLAYING: u32 = 2;
+/// `runtime_state` value when no program runs (STOPPED).
+pub const RUNTIME_STATE_STOPPED: u32 = 1;
+/// `runtime_state` value of a paused program (PAUSED).
+pub const RUNTIME_STATE_PAUSED: u32 = 4;
 /// `joint_mode` value of a running joint (JOINT_RUNNING_MODE).
 pub const JOINT_MODE_RUNNING: i32 = 253;
 
@@ -36,9 +42,11 @@ pub struct RobotOutputs {
     pub actual_tcp_force: [f64; 6],
     /// Commanded TCP pose.
     pub target_tcp_pose: [f64; 6],
+    /// The TCP's offset from the tool flange (m, rotation vector in rad; zeros: the flange).
+    pub tcp_offset: [f64; 6],
     /// Robot mode (7 running).
     pub robot_mode: i32,
-    /// Safety mode (1 normal).
+    /// Safety mode (1 normal, 3 protective stop); also served as `safety_status`.
     pub safety_mode: i32,
     /// Runtime state (2 playing).
     pub runtime_state: u32,
@@ -66,6 +74,7 @@ impl Default for RobotOutputs {
             actual_tcp_speed: [0.0; 6],
             actual_tcp_force: [0.0; 6],
             target_tcp_pose: [0.0; 6],
+            tcp_offset: [0.0; 6],
             robot_mode: ROBOT_MODE_RUNNING,
             safety_mode: SAFETY_MODE_NORMAL,
             runtime_state: RUNTIME_STATE_PLAYING,
@@ -149,8 +158,10 @@ pub(crate) enum OutputSource {
     ActualTcpSpeed,
     ActualTcpForce,
     TargetTcpPose,
+    TcpOffset,
     RobotMode,
     SafetyMode,
+    SafetyStatusBits,
     RuntimeState,
     SpeedScaling,
     TargetSpeedFraction,
@@ -182,6 +193,7 @@ impl OutputSource {
             "actual_TCP_speed" => ActualTcpSpeed,
             "actual_TCP_force" => ActualTcpForce,
             "target_TCP_pose" => TargetTcpPose,
+            "tcp_offset" => TcpOffset,
             "robot_mode" => RobotMode,
             "safety_mode" => SafetyMode,
             "runtime_state" => RuntimeState,
@@ -193,8 +205,9 @@ impl OutputSource {
             "input_bit_registers0_to_31" => InputBitWord(0),
             "input_bit_registers32_to_63" => InputBitWord(1),
             "joint_mode" => Constant(RtdeValue::Vector6Int32([JOINT_MODE_RUNNING; 6])),
-            "safety_status" => Constant(RtdeValue::Int32(SAFETY_MODE_NORMAL)),
-            "safety_status_bits" => Constant(RtdeValue::Uint32(1)), // bit 0: normal mode
+            // safety_status uses safety_mode's values (finer only in states the twin never enters).
+            "safety_status" => SafetyMode,
+            "safety_status_bits" => SafetyStatusBits,
             _ => Constant(RtdeValue::zero(t)),
         }
     }
@@ -213,8 +226,17 @@ impl OutputSource {
             ActualTcpSpeed => V::Vector6d(out.actual_tcp_speed),
             ActualTcpForce => V::Vector6d(out.actual_tcp_force),
             TargetTcpPose => V::Vector6d(out.target_tcp_pose),
+            TcpOffset => V::Vector6d(out.tcp_offset),
             RobotMode => V::Int32(out.robot_mode),
             SafetyMode => V::Int32(out.safety_mode),
+            SafetyStatusBits => {
+                // Bit 0 normal mode, bit 2 protective stopped (RTDE guide).
+                V::Uint32(match out.safety_mode {
+                    SAFETY_MODE_NORMAL => 1,
+                    SAFETY_MODE_PROTECTIVE_STOP => 1 << 2,
+                    _ => 0,
+                })
+            }
             RuntimeState => V::Uint32(out.runtime_state),
             SpeedScaling => V::Double(out.speed_scaling),
             TargetSpeedFraction => V::Double(out.target_speed_fraction),
