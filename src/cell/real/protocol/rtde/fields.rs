@@ -91,8 +91,8 @@ pub const FIXED_OUTPUTS: &[(&str, RtdeType)] = &[
     ("joint_position_deviation_ratio", Double),
     ("collision_detection_ratio", Double),
     // Added after SDU ur_rtde's `RTDEReceiveInterface` with all variables hit "Unknown data
-    // type: NOT_FOUND" on them. Types as in UR's RTDE guide output table (cross-checked against
-    // the type table of the fake RTDE server in UR's own `ur_client_library` tests). Values:
+    // type: NOT_FOUND" on them. Types from the type table of the fake RTDE server in UR's own
+    // `ur_client_library` tests (UR's RTDE guide itself was not at hand to check). Values:
     // `tcp_offset` is the configured TCP offset ([`RobotOutputs::tcp_offset`], zeros: we set none);
     // the configurable digital IO bits are 0 (nothing wired) and both encoders read 0 (none fitted).
     ("tcp_offset", Vector6d),
