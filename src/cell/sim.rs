@@ -61,6 +61,8 @@ pub struct SimCell {
     /// The physics readout after the last step, read once per tick by `read`, the sensor and
     /// the ground truth alike.
     readout: PhysicsReadout,
+    /// The MuJoCo states recorded for `tendril render` ([`SimCell::record_frames`]).
+    frames: Option<crate::render::frames::FrameRecorder>,
 }
 
 impl SimCell {
@@ -101,7 +103,21 @@ impl SimCell {
             latest: Wavelengths { fbg1_nm: 0.0, fbg2_nm: 0.0 },
             next_sample_s: 0.0,
             readout: PhysicsReadout::default(),
+            frames: None,
         }
+    }
+
+    /// Records the scene's MuJoCo state at `fps` frames per second of cell time from activation on
+    /// (for `tendril render`); [`SimCell::take_frames`] hands them over.
+    /// Reading the state changes nothing in the run.
+    pub fn record_frames(&mut self, fps: f64) {
+        self.frames = Some(crate::render::frames::FrameRecorder::new(fps));
+    }
+
+    /// The frames recorded so far, if [`SimCell::record_frames`] was asked for and the backend has
+    /// a MuJoCo state.
+    pub fn take_frames(&mut self) -> Option<crate::render::frames::FrameLog> {
+        self.frames.as_mut()?.take()
     }
 
     /// The cell a pick-and-place scenario describes, over its compiled scene model.
@@ -164,6 +180,9 @@ impl Cell for SimCell {
         require_state(self.lifecycle, Lifecycle::Inactive, "activate")?;
         self.lifecycle = Lifecycle::Active;
         self.sample_sensor();
+        if let (Some(frames), Some(scene)) = (self.frames.as_mut(), self.scene.as_deref()) {
+            frames.offer(scene);
+        }
         Ok(())
     }
 
@@ -200,6 +219,9 @@ impl Cell for SimCell {
         let half_step = 0.5 * scene.timestep();
         while scene.time() < time_s - half_step {
             scene.step().map_err(Self::physics_error)?;
+            if let Some(frames) = self.frames.as_mut() {
+                frames.offer(scene.as_ref());
+            }
         }
         self.sample_sensor();
         Ok(())
