@@ -252,7 +252,10 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
         }
     };
     let mut options = mujoco_rs::wrappers::mj_visualization::MjvOption::default();
-    options.flags[mjtVisFlag::mjVIS_CONTACTFORCE as usize] = 1;
+    // Contact forces as MuJoCo draws them. A rapier run's states are drawn through the same model,
+    // but MuJoCo's contact solve at rapier's penetrations is not rapier's force: left out there.
+    let mujoco = scenario.scene_spec().physics.backend == crate::cell::physics::Backend::Mujoco;
+    options.flags[mjtVisFlag::mjVIS_CONTACTFORCE as usize] = u8::from(mujoco);
     options.frame = mjtFrame::mjFRAME_NONE as i32;
     let mut renderer = MjRenderer::builder()
         .width(opts.width)

@@ -32,7 +32,7 @@ impl ModelCache {
 }
 
 /// Runs `scenario` on the twin. With `out`, writes `trace.csv` (streamed, kept on failure),
-/// `summary.json`, `scenario.toml` and, on the MuJoCo backend, `frames.bin` (the scene's state at
+/// `summary.json`, `scenario.toml` and `frames.bin` (the scene's state in MuJoCo's layout at
 /// 30 frames/s of cell time, for `tendril render`) there. A physics failure is an `error` outcome
 /// in the summary, not an `Err`; `Err` is for what prevents the run from starting (scene does not compile, folder not writable).
 pub fn run_on_twin(
