@@ -164,7 +164,7 @@ impl FrameLog {
             na: u32_at(24) as usize,
         };
         let (fps, timestep_s) = (f64_at(28), f64_at(36));
-        if !(fps.is_finite() && fps > 0.0) || !(timestep_s.is_finite() && timestep_s > 0.0) {
+        if !(fps.is_finite() && fps > 0.0 && timestep_s.is_finite() && timestep_s > 0.0) {
             return Err(bad(format!("rate {fps} frames/s or timestep {timestep_s} s is not a positive number")));
         }
         if sizes.nq == 0 || sizes.total() > 1 << 20 {
@@ -173,7 +173,7 @@ impl FrameLog {
         let n = sizes.total();
         let record = 8 + 4 * n;
         let body = &b[HEADER_LEN..];
-        if body.len() % record != 0 {
+        if !body.len().is_multiple_of(record) {
             return Err(bad(format!(
                 "{} bytes of frames are not a whole number of {record}-byte frames (a cut-off file?)",
                 body.len()

@@ -92,7 +92,7 @@ impl RenderOptions {
     /// Checks the options, naming the one at fault.
     pub fn check(&self) -> anyhow::Result<()> {
         let side = |name: &str, v: u32| {
-            if v < 16 || v > MAX_SIDE || v % 2 != 0 {
+            if !(16..=MAX_SIDE).contains(&v) || !v.is_multiple_of(2) {
                 anyhow::bail!(
                     "--{name} {v}: must be an even number of pixels from 16 to {MAX_SIDE} (H.264 needs even sides)"
                 );
@@ -230,7 +230,8 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
                     .filter_map(|c| model.id_to_name(_mjtObjBase::mjOBJ_CAMERA, c))
                     .collect();
                 anyhow::anyhow!(
-                    "--camera {name}: the scene has no such camera (it has: {}); leave --camera out for the free camera on the object",
+                    "--camera {name}: the scene has no such camera (it has: {}); leave --camera out for \
+                     the free camera on the object",
                     if names.is_empty() { "none".to_string() } else { names.join(", ") }
                 )
             })?;

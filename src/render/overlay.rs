@@ -9,6 +9,9 @@ use plotters::prelude::*;
 /// Cursor colour.
 const CURSOR: RGBColor = RGBColor(200, 30, 30);
 
+/// A plotted series: its value, colour and legend.
+type Series = (fn(&TracePoint) -> f64, RGBColor, &'static str);
+
 /// The force panel of one run at one size.
 pub struct Panel {
     points: Vec<TracePoint>,
@@ -70,7 +73,7 @@ impl Panel {
                 .y_label_formatter(&|f| format!("{f:.1} N"))
                 .draw()
                 .map_err(draw_error)?;
-            let series: [(fn(&TracePoint) -> f64, RGBColor, &str); 3] = [
+            let series: [Series; 3] = [
                 (|p| p.setpoint_n, RGBColor(120, 120, 120), "setpoint"),
                 (|p| p.true_force_n, RGBColor(20, 20, 20), "true"),
                 (|p| p.force_n, style::SERIES[0], "estimate"),

@@ -34,7 +34,8 @@ impl ModelCache {
 /// Runs `scenario` on the twin. With `out`, writes `trace.csv` (streamed, kept on failure),
 /// `summary.json`, `scenario.toml` and `frames.bin` (the scene's state in MuJoCo's layout at
 /// 30 frames/s of cell time, for `tendril render`) there. A physics failure is an `error` outcome
-/// in the summary, not an `Err`; `Err` is for what prevents the run from starting (scene does not compile, folder not writable).
+/// in the summary, not an `Err`; `Err` is for what prevents the run from starting (scene does not
+/// compile, folder not writable).
 pub fn run_on_twin(
     scenario: &PickPlaceScenario,
     models: &ModelCache,
@@ -72,6 +73,9 @@ pub fn run_on_cell(
     let mut trace = match out {
         Some(dir) => {
             std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+            // Frames of an earlier run in this folder are not this run's (a run on the real cell
+            // records none; a twin run writes its own after the run).
+            let _ = std::fs::remove_file(dir.join(crate::render::frames::FRAMES_FILE));
             let path = dir.join("trace.csv");
             Some(TraceWriter::create(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?)
         }

@@ -84,12 +84,7 @@ impl Physics for RapierScene {
                 _ => {}
             }
         }
-        Some(crate::render::Snapshot {
-            qpos,
-            qvel,
-            ctrl: self.world.ctrl.clone(),
-            act: vec![0.0; m.ffi().na as usize],
-        })
+        Some(crate::render::Snapshot { qpos, qvel, ctrl: self.world.ctrl.clone(), act: vec![0.0; m.ffi().na as usize] })
     }
 
     fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
