@@ -294,7 +294,7 @@ mod tests {
         }
         let back = FrameLog::from_bytes(&log.to_bytes(), "x").unwrap();
         assert_eq!(back, log);
-        assert_eq!(back.frame(1).unwrap()[3], -(log.times[1] as f32));
+        assert_eq!(back.frame(1).unwrap()[2], -(log.times[1] as f32));
         let mut cut = log.to_bytes();
         cut.pop();
         assert!(FrameLog::from_bytes(&cut, "x").unwrap_err().to_string().contains("cut-off"));
