@@ -16,6 +16,7 @@
 //! - [`control`]: what runs the same on the twin and on the real cell.
 //! - [`calibration`]: the paper's calibration procedures, for simulated or recorded bench data.
 //! - [`reproduce`]: the paper's figures next to the twin's.
+//! - [`render`]: videos of finished runs (`tendril render`), from the MuJoCo states a run records.
 //! - [`mujoco_log`]: MuJoCo's warnings into our log and summaries (no `MUJOCO_LOG.TXT`).
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
 //! - [`signals`]: the data types that cross the seam (wavelengths, ...).
@@ -30,6 +31,7 @@ pub mod hardware;
 pub mod interrupt;
 pub mod mujoco_log;
 pub mod plot;
+pub mod render;
 pub mod reproduce;
 pub mod run;
 pub mod scenario;

@@ -69,6 +69,8 @@ pub struct SimCell {
     fresh_sample: bool,
     /// Whether the object force is currently set (so it is cleared once, after the push).
     pushing: bool,
+    /// The MuJoCo states recorded for `tendril render` ([`SimCell::record_frames`]).
+    frames: Option<crate::render::frames::FrameRecorder>,
 }
 
 impl SimCell {
@@ -112,6 +114,7 @@ impl SimCell {
             disturbances: DisturbanceSchedule::default(),
             fresh_sample: true,
             pushing: false,
+            frames: None,
         }
     }
 
@@ -121,6 +124,19 @@ impl SimCell {
     pub fn with_disturbances(mut self, disturbances: DisturbanceConfig) -> SimCell {
         self.disturbances = DisturbanceSchedule::new(disturbances);
         self
+    }
+
+    /// Records the scene's MuJoCo state at `fps` frames per second of cell time from activation on
+    /// (for `tendril render`); [`SimCell::take_frames`] hands them over.
+    /// Reading the state changes nothing in the run.
+    pub fn record_frames(&mut self, fps: f64) {
+        self.frames = Some(crate::render::frames::FrameRecorder::new(fps));
+    }
+
+    /// The frames recorded so far, if [`SimCell::record_frames`] was asked for and the backend has
+    /// a MuJoCo state.
+    pub fn take_frames(&mut self) -> Option<crate::render::frames::FrameLog> {
+        self.frames.as_mut()?.take()
     }
 
     /// The cell a pick-and-place scenario describes, over its compiled scene model.
@@ -193,6 +209,9 @@ impl Cell for SimCell {
         require_state(self.lifecycle, Lifecycle::Inactive, "activate")?;
         self.lifecycle = Lifecycle::Active;
         self.sample_sensor();
+        if let (Some(frames), Some(scene)) = (self.frames.as_mut(), self.scene.as_deref()) {
+            frames.offer(scene);
+        }
         Ok(())
     }
 
@@ -237,6 +256,9 @@ impl Cell for SimCell {
                 }
             }
             scene.step().map_err(Self::physics_error)?;
+            if let Some(frames) = self.frames.as_mut() {
+                frames.offer(scene.as_ref());
+            }
         }
         self.sample_sensor();
         Ok(())

@@ -6,6 +6,7 @@ mod latency;
 mod physics;
 mod plot;
 mod realtime;
+mod render;
 mod reproduce;
 mod run;
 mod sensor;
@@ -32,6 +33,9 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
     /// Run one pick-and-place scenario on the twin; writes DIR/trace.csv and DIR/summary.json.
     Run(run::RunArgs),
+    /// Render a finished run (its frames.bin) as an MP4 video with the force trace under the
+    /// picture; offscreen through EGL, no display needed.
+    Render(render::RenderArgs),
     /// Run a sweep over scenario keys in parallel; writes DIR/results.csv as runs finish.
     Sweep(sweep::SweepArgs),
     /// Merge the results files of a sharded sweep into one.
@@ -67,6 +71,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Reproduce(a) => reproduce::run(a),
         Command::Run(a) => run::run(a),
+        Command::Render(a) => render::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Merge(a) => sweep::merge(a),
         Command::Plot(a) => plot::run(a),

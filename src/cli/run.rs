@@ -72,6 +72,11 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         run_on_twin(&scenario, &Default::default(), Some(&dir))?
     };
     emit(&render_text(&summary));
-    emit(&format!("wrote {0}/trace.csv, {0}/summary.json and {0}/scenario.toml\n", dir.display()));
+    let frames = if dir.join(crate::render::frames::FRAMES_FILE).is_file() && a.hardware == "sim" {
+        format!(", {}/{}", dir.display(), crate::render::frames::FRAMES_FILE)
+    } else {
+        String::new()
+    };
+    emit(&format!("wrote {0}/trace.csv, {0}/summary.json{frames} and {0}/scenario.toml\n", dir.display()));
     Ok(super::exit_for_runs(summary.outcome == "error"))
 }

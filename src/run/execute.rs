@@ -1,5 +1,5 @@
 //! One scenario, start to finish, on the twin: build (or reuse) the scene model, run the task,
-//! write `trace.csv` and `summary.json`.
+//! write `trace.csv`, `summary.json` and `frames.bin`.
 
 use super::runner::{RunReport, run_task};
 use super::scenario::PickPlaceScenario;
@@ -31,9 +31,11 @@ impl ModelCache {
     }
 }
 
-/// Runs `scenario` on the twin. With `out`, writes `trace.csv` (streamed, kept on failure) and
-/// `summary.json` there. A physics failure is an `error` outcome in the summary, not an `Err`;
-/// `Err` is for what prevents the run from starting (scene does not compile, folder not writable).
+/// Runs `scenario` on the twin. With `out`, writes `trace.csv` (streamed, kept on failure),
+/// `summary.json`, `scenario.toml` and `frames.bin` (the scene's state in MuJoCo's layout at
+/// 30 frames/s of cell time, for `tendril render`) there. A physics failure is an `error` outcome
+/// in the summary, not an `Err`; `Err` is for what prevents the run from starting (scene does not
+/// compile, folder not writable).
 pub fn run_on_twin(
     scenario: &PickPlaceScenario,
     models: &ModelCache,
@@ -43,7 +45,20 @@ pub fn run_on_twin(
     // Warnings left on this thread by an earlier run are not this run's.
     let _ = crate::mujoco_log::take_warnings();
     let mut cell = SimCell::for_scenario(scenario, models.get(&scenario.scene_spec())?);
-    run_on_cell(&mut cell, scenario, out, started)
+    if out.is_some() {
+        cell.record_frames(crate::render::frames::RECORD_FPS);
+    }
+    let result = run_on_cell(&mut cell, scenario, out, started);
+    // The frames too when the run failed to write a file: they show what happened.
+    if let (Some(dir), Some(frames)) = (out, cell.take_frames())
+        && let Err(e) = frames.write(&dir.join(crate::render::frames::FRAMES_FILE))
+    {
+        return Err(match result {
+            Ok(_) => anyhow::anyhow!("{e}: cannot write"),
+            Err(first) => anyhow::anyhow!("{first:#}; {e}: cannot write"),
+        });
+    }
+    result
 }
 
 /// Runs `scenario` on any cell, writing `trace.csv` and `summary.json` into `out` when given;
@@ -58,6 +73,9 @@ pub fn run_on_cell(
     let mut trace = match out {
         Some(dir) => {
             std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+            // Frames of an earlier run in this folder are not this run's (a run on the real cell
+            // records none; a twin run writes its own after the run).
+            let _ = std::fs::remove_file(dir.join(crate::render::frames::FRAMES_FILE));
             let path = dir.join("trace.csv");
             Some(TraceWriter::create(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?)
         }

@@ -69,6 +69,12 @@ pub trait Physics: Send {
         })
     }
 
+    /// The whole scene's state in MuJoCo's layout (qpos, qvel, ctrl, act of the compiled
+    /// [`SceneModel`]), recorded for `tendril render`; `None` when the backend has no such state.
+    fn snapshot(&self) -> Option<crate::render::Snapshot> {
+        None
+    }
+
     /// Steps for `seconds` of simulated time (rounded to whole steps).
     fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
         let n = (seconds / self.timestep()).round() as usize;

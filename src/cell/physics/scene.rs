@@ -406,6 +406,16 @@ impl Physics for Scene {
         self.shared.spec.physics.timestep_s
     }
 
+    fn snapshot(&self) -> Option<crate::render::Snapshot> {
+        let d = &self.data;
+        Some(crate::render::Snapshot {
+            qpos: d.qpos().to_vec(),
+            qvel: d.qvel().to_vec(),
+            ctrl: d.ctrl().to_vec(),
+            act: d.act().to_vec(),
+        })
+    }
+
     fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
         self.drive.set_growth(growth_m)
     }

@@ -61,6 +61,32 @@ impl Physics for RapierScene {
         self.world.timestep()
     }
 
+    /// Rapier's state in MuJoCo's layout: hinge and slide joints from the multibody, a free joint
+    /// from its body's pose (velocity 0: only drawn contact forces use it), controls as commanded,
+    /// activations 0.
+    fn snapshot(&self) -> Option<crate::render::Snapshot> {
+        use mujoco_rs::mujoco_c::mjtJoint;
+        let m = self.shared.model();
+        let mut qpos = m.qpos0().to_vec();
+        let mut qvel = vec![0.0; m.ffi().nv as usize];
+        for j in 0..m.ffi().njnt as usize {
+            let (adr, dof) = (m.jnt_qposadr()[j] as usize, m.jnt_dofadr()[j] as usize);
+            match m.jnt_type()[j] {
+                mjtJoint::mjJNT_HINGE | mjtJoint::mjJNT_SLIDE => {
+                    qpos[adr] = self.world.joint_position(j);
+                    qvel[dof] = self.world.joint_velocity(j);
+                }
+                mjtJoint::mjJNT_FREE => {
+                    let p = self.world.body_pose(m.jnt_bodyid()[j] as usize);
+                    let (t, q) = (p.translation, p.rotation);
+                    qpos[adr..adr + 7].copy_from_slice(&[t.x, t.y, t.z, q.w, q.x, q.y, q.z]);
+                }
+                _ => {}
+            }
+        }
+        Some(crate::render::Snapshot { qpos, qvel, ctrl: self.world.ctrl.clone(), act: vec![0.0; m.ffi().na as usize] })
+    }
+
     fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
         self.drive.set_growth(growth_m)
     }

@@ -1,0 +1,77 @@
+//! `tendril render`.
+
+use crate::render::{RenderOptions, render_run};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `tendril render`.
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// A run directory written by `tendril run` (frames.bin, scenario.toml, trace.csv).
+    run_dir: PathBuf,
+    /// The video file to write [default: RUN_DIR/video.mp4].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Frames per second of video.
+    #[arg(long, default_value_t = 30.0)]
+    fps: f64,
+    /// Width of the picture [px] (even).
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Height of the rendered scene [px] (even); the force panel adds a third below.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Cell seconds per video second (2: twice as fast as the cell ran).
+    #[arg(long, default_value_t = 1.0)]
+    speed: f64,
+    /// A camera of the scene's model by name [default: a free camera on the object's start
+    /// position].
+    #[arg(long)]
+    camera: Option<String>,
+    /// Free camera: distance from the object [m].
+    #[arg(long, default_value_t = 0.35)]
+    distance: f64,
+    /// Free camera: azimuth [°].
+    #[arg(long, default_value_t = 135.0, allow_negative_numbers = true)]
+    azimuth: f64,
+    /// Free camera: elevation [°] (negative looks down).
+    #[arg(long, default_value_t = -20.0, allow_negative_numbers = true)]
+    elevation: f64,
+    /// Leave out the force panel under the picture.
+    #[arg(long)]
+    no_panel: bool,
+    /// Also write the picture at this cell time [s] as a PNG (beside the video, `.png`).
+    #[arg(long)]
+    still: Option<f64>,
+}
+
+/// `tendril render`: a run's recorded frames as an MP4 video.
+pub fn run(a: RenderArgs) -> anyhow::Result<ExitCode> {
+    let opts = RenderOptions {
+        out: a.out.clone().unwrap_or_else(|| a.run_dir.join("video.mp4")),
+        fps: a.fps,
+        width: a.width,
+        height: a.height,
+        speed: a.speed,
+        camera: a.camera.clone(),
+        distance_m: a.distance,
+        azimuth_deg: a.azimuth,
+        elevation_deg: a.elevation,
+        panel: !a.no_panel,
+        still_s: a.still,
+    };
+    let stats = render_run(&a.run_dir, &opts)?;
+    super::emit(&format!(
+        "wrote {} ({} frames, {}x{}, {:.1} s of cell time, {:.0} kB) in {:.1} s: {:.1} frames/s, {:.2} cell s per s\n",
+        opts.out.display(),
+        stats.frames,
+        stats.size.0,
+        stats.size.1,
+        stats.cell_s,
+        stats.bytes as f64 / 1000.0,
+        stats.wall_s,
+        stats.frames_per_s(),
+        stats.cell_s_per_s()
+    ));
+    Ok(ExitCode::SUCCESS)
+}
