@@ -48,6 +48,41 @@ impl Default for MoveOutlook {
     }
 }
 
+impl MoveOutlook {
+    /// A schedule σ in [0, 1] that ramps linearly from 0 to 1 over the `lead_s` seconds before the
+    /// arm moves and stays 1 while it moves (0 with no move ahead, or no lead before it starts).
+    pub fn lead_ramp(&self, lead_s: f64) -> f64 {
+        let tau = self.time_to_motion_s;
+        if tau <= 0.0 {
+            1.0
+        } else if lead_s <= 0.0 || !tau.is_finite() {
+            0.0
+        } else {
+            (1.0 - tau / lead_s).clamp(0.0, 1.0)
+        }
+    }
+
+    /// Whether the arm is moving the object now.
+    pub fn moving(&self) -> bool {
+        self.time_to_motion_s <= 0.0
+    }
+}
+
+impl ControlContext {
+    /// The travel-limit flag for a controller that tracks `target_n` instead of the nominal
+    /// setpoint: the task computed it for the direction towards the setpoint, so it holds only
+    /// when the target lies on the same side of the estimate.
+    pub fn blocked_towards(&self, target_n: f64) -> bool {
+        self.blocked && ((target_n > self.force_n) == (self.setpoint_n > self.force_n))
+    }
+
+    /// `speed_deg_s` with loosening limited to `max_release_deg_s` while the arm moves (the
+    /// scheduled controllers' clamp: a knock that saturates the sensor must not make them let go).
+    pub fn release_limited(&self, speed_deg_s: f64, max_release_deg_s: f64) -> f64 {
+        if self.outlook.moving() { speed_deg_s.max(-max_release_deg_s) } else { speed_deg_s }
+    }
+}
+
 /// Everything a force controller is told each tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControlContext {

@@ -123,14 +123,7 @@ impl Feedforward {
     /// The scheduled setpoint F* \[N\] for this tick.
     pub fn scheduled_setpoint_n(&self, ctx: &ControlContext) -> f64 {
         let c = &self.config;
-        let tau = ctx.outlook.time_to_motion_s;
-        let sigma = if tau <= 0.0 {
-            1.0
-        } else if c.lead_s <= 0.0 || !tau.is_finite() {
-            0.0
-        } else {
-            (1.0 - tau / c.lead_s).clamp(0.0, 1.0)
-        };
+        let sigma = ctx.outlook.lead_ramp(c.lead_s);
         ctx.setpoint_n * (1.0 + sigma * (c.margin + c.accel_gain * ctx.outlook.peak_accel_rad_s2))
     }
 }
@@ -138,10 +131,8 @@ impl Feedforward {
 impl ForceController for Feedforward {
     fn update(&mut self, ctx: &ControlContext) -> f64 {
         let setpoint = self.scheduled_setpoint_n(ctx);
-        // The travel-limit flag was computed against the nominal setpoint; recompute the direction.
-        let blocked = ctx.blocked && ((setpoint > ctx.force_n) == (ctx.setpoint_n > ctx.force_n));
-        let u = self.pid.update(setpoint, ctx.force_n, ctx.dt_s, blocked);
-        if ctx.outlook.time_to_motion_s <= 0.0 { u.max(-self.config.max_release_deg_s) } else { u }
+        let u = self.pid.update(setpoint, ctx.force_n, ctx.dt_s, ctx.blocked_towards(setpoint));
+        ctx.release_limited(u, self.config.max_release_deg_s)
     }
 
     fn reset(&mut self) {

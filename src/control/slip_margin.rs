@@ -147,14 +147,7 @@ impl SlipMargin {
     pub fn target_n(&self, ctx: &ControlContext) -> f64 {
         let c = &self.config;
         let o = &ctx.outlook;
-        let tau = o.time_to_motion_s;
-        let sigma = if tau <= 0.0 {
-            1.0
-        } else if c.lead_s <= 0.0 || !tau.is_finite() {
-            0.0
-        } else {
-            (1.0 - tau / c.lead_s).clamp(0.0, 1.0)
-        };
+        let sigma = o.lead_ramp(c.lead_s);
         let accel = c.lever_m * (o.peak_accel_rad_s2 + o.peak_speed_rad_s.powi(2));
         let load_factor = 1.0 + sigma * accel / G_M_S2;
         // F_sp · max(1, (1 + margin) / (1 + static_margin) · n): equal margins at rest give the
@@ -174,10 +167,9 @@ impl ForceController for SlipMargin {
             _ => 0.0,
         };
         self.previous_target_n = Some(target);
-        let blocked = ctx.blocked && ((target > ctx.force_n) == (ctx.setpoint_n > ctx.force_n));
-        let u = (self.pid.update(target, ctx.force_n, ctx.dt_s, blocked) + rate)
+        let u = (self.pid.update(target, ctx.force_n, ctx.dt_s, ctx.blocked_towards(target)) + rate)
             .clamp(-c.max_speed_deg_s, c.max_speed_deg_s);
-        if ctx.outlook.time_to_motion_s <= 0.0 { u.max(-c.max_release_deg_s) } else { u }
+        ctx.release_limited(u, c.max_release_deg_s)
     }
 
     fn reset(&mut self) {
