@@ -48,8 +48,6 @@ pub const MIN_CURL_RADIUS_M: f64 = 0.00875;
 /// curled by a tendon on one side and never bends far the other way.
 pub const MIN_BACK_RADIUS_M: f64 = 0.0175 / 0.3;
 
-/// Half the sensor pad's casing length along the strip \[m\] (12 mm casing, paper Sec. II).
-pub const PAD_HALF_LENGTH_M: f64 = 0.006;
 
 /// The segment template without its `<joint .../>` element: a segment welded to its parent.
 fn without_joint(segment: &str) -> String {
@@ -114,19 +112,10 @@ pub fn header(p: &PhysicsConfig) -> String {
 pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, PhysicsError> {
     let (finger_text, segment_text, pad_text) =
         (part(models, "finger.xml")?, part(models, "finger_segment.xml")?, part(models, "sensor_pad.xml")?);
-    let n = f.segments as usize;
-    let l = f.segment_length_m();
+    let pieces = super::strip::layout(f);
     let r = f.thickness_m / 2.0;
-    let seg_mass = f.density_kg_m3 * l * f.width_m * f.thickness_m;
-    // The pad's casing is rigid: the strip cannot bend under it. A joint whose hinge falls under
-    // the casing is left out, so that stretch moves as one body whatever the number of links, and
-    // the pad goes on the segment where the casing starts (at 8 links it fits on one segment and no
-    // joint is left out; at 16 the joint at its centre is).
-    let half_pad = PAD_HALF_LENGTH_M;
-    let bends =
-        |i: usize| i == 0 || !(f.pad_position_m - half_pad..=f.pad_position_m + half_pad).contains(&(i as f64 * l));
-    let pad_seg = (((f.pad_position_m - half_pad) / l).floor() as usize).min(n - 1);
-    let pad_x = f.pad_position_m - pad_seg as f64 * l;
+    let pad_seg = pieces.iter().position(|p| p.fixed).unwrap_or(0);
+    let pad_x = f.pad_position_m - pieces[pad_seg].start_m;
     // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
     let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
     let pad = render(
@@ -141,31 +130,36 @@ pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, Physics
     )?;
     let segment_body = body_of(&segment_text);
     let rigid_body = without_joint(segment_body);
+    // A joint between two rigid pieces stands for no strip: the pieces are welded.
+    let bends = |p: &super::strip::Piece| p.joint_span_m > 0.0;
     let mut chain = String::new();
-    for i in (0..n).rev() {
+    for (i, piece) in pieces.iter().enumerate().rev() {
+        let previous = if i == 0 { 0.0 } else { pieces[i - 1].length_m };
+        let span = piece.joint_span_m;
+        let l = piece.length_m;
         chain = render(
-            if bends(i) { segment_body } else { &rigid_body },
+            if bends(piece) { segment_body } else { &rigid_body },
             &[
                 ("i", i.to_string()),
-                ("x", num(if i == 0 { 0.0 } else { l })),
+                ("x", num(previous)),
                 // Helix: each segment one step towards the flange (-z in the hand frame).
-                ("z", num(if i == 0 { 0.0 } else { -f.helix_slope * l })),
-                ("k_bend", num(f.bending_stiffness_n_m2 / l)),
-                ("d_bend", num(per_joint(f.bending_damping_n_m2_s / l))),
-                ("a_bend", num(per_joint(f.bending_armature_kg_m3 / l))),
-                ("min_curl", num(-per_joint(l / MIN_BACK_RADIUS_M))),
-                ("max_curl", num(per_joint(l / MIN_CURL_RADIUS_M))),
+                ("z", num(-f.helix_slope * previous)),
+                ("k_bend", num(per_joint(f.bending_stiffness_n_m2 / span))),
+                ("d_bend", num(per_joint(f.bending_damping_n_m2_s / span))),
+                ("a_bend", num(per_joint(f.bending_armature_kg_m3 / span))),
+                ("min_curl", num(-per_joint(span / MIN_BACK_RADIUS_M))),
+                ("max_curl", num(per_joint(span / MIN_CURL_RADIUS_M))),
                 ("half_len", num(l / 2.0)),
                 ("half_width", num(f.width_m / 2.0)),
                 ("radius", num(r)),
-                ("mass", num(seg_mass)),
+                ("mass", num(f.density_kg_m3 * l * f.width_m * f.thickness_m)),
                 ("pad", if i == pad_seg { pad.clone() } else { String::new() }),
                 ("child", chain),
             ],
         )?;
     }
-    let curl_terms: String = (0..n)
-        .filter(|&i| bends(i))
+    let curl_terms: String = (0..pieces.len())
+        .filter(|&i| bends(&pieces[i]))
         .map(|i| format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(f.moment_arm_m)))
         .collect();
     let k = f.tendon_stiffness_n_m;

@@ -19,6 +19,7 @@ pub mod config;
 pub mod drive;
 pub mod export;
 pub mod object;
+pub mod strip;
 pub mod rapier;
 pub mod scene;
 pub mod template;

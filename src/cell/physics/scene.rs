@@ -124,7 +124,7 @@ impl SceneModel {
         let act = |n: &str| id(m, mjOBJ_ACTUATOR, "actuator", n);
         let pad_geoms = vec![geom("pad_casing")?, geom("pad_bump")?];
         let mut finger_geoms = pad_geoms.clone();
-        for i in 0..spec.finger.segments {
+        for i in 0..super::strip::layout(&spec.finger).len() {
             finger_geoms.push(geom(&format!("seg{i}"))?);
         }
         let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() {

@@ -1,0 +1,94 @@
+//! How the strip is cut into links: the discretisation of the finger (see models/README.md, "The
+//! finger as a discretised strip").
+//!
+//! The strip is flexible except for two pieces of fixed physical size: the sensor pad's rigid
+//! 12 mm casing and the tendon's anchor at the tip. A tendon pulled along a strip bends it by the
+//! same moment everywhere, so the strip bears on the object only where that moment changes: at
+//! the tip (where the tendon ends), at the pad (which stands proud) and where the wrap begins. The
+//! forces there are set by the size of those pieces, so the pieces must be the same at any number
+//! of links: their edges are joints, and the uniform grid of `finger.segments` links cuts only the
+//! flexible stretches between them.
+
+use super::config::FingerConfig;
+
+/// Half the sensor pad's casing length \[m\] (12 mm casing, paper Sec. II).
+pub const PAD_HALF_LENGTH_M: f64 = 0.006;
+
+/// Length of the rigid piece at the strip's tip that anchors the tendon \[m\]. A stated choice:
+/// 10 mm, a tendon anchor block of about the strip's width; not published.
+pub const TIP_LENGTH_M: f64 = 0.01;
+
+/// One rigid link of the discretised strip.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Piece {
+    /// Arc length of the piece's start from the strip's base \[m\].
+    pub start_m: f64,
+    /// Length of the piece \[m\].
+    pub length_m: f64,
+    /// Whether this piece is one of the fixed rigid pieces (pad casing, tip anchor) rather than a
+    /// cut of the flexible strip.
+    pub fixed: bool,
+    /// Length of flexible strip the joint at the piece's start stands for \[m\]: half of each
+    /// flexible neighbour (a joint between a flexible piece and a rigid one bends only for the
+    /// flexible half). Per-joint stiffness, damping and armature are the per-length values
+    /// divided by it.
+    pub joint_span_m: f64,
+}
+
+/// The pieces of the strip, base to tip, for `f`: the uniform grid of `f.segments` links with the
+/// pad casing and the tip anchor as single pieces, and grid points closer than half a link to a
+/// piece's edge dropped (no slivers).
+pub fn layout(f: &FingerConfig) -> Vec<Piece> {
+    let l = f.segment_length_m();
+    let length = f.length_m;
+    let pad = (f.pad_position_m - PAD_HALF_LENGTH_M, f.pad_position_m + PAD_HALF_LENGTH_M);
+    let tip = length - TIP_LENGTH_M.min(length / 4.0);
+    let edges = [pad.0, pad.1, tip];
+    let inside_fixed = |s: f64| (s > pad.0 && s < pad.1) || s > tip;
+    let mut cuts: Vec<f64> = (1..f.segments)
+        .map(|i| f64::from(i) * l)
+        .filter(|&s| !inside_fixed(s) && edges.iter().all(|e| (s - e).abs() >= l / 2.0 - 1e-12))
+        .collect();
+    cuts.extend(edges);
+    cuts.push(0.0);
+    cuts.sort_by(f64::total_cmp);
+    let fixed = |start: f64| (start - pad.0).abs() < 1e-12 || (start - tip).abs() < 1e-12;
+    let mut pieces: Vec<Piece> = cuts
+        .iter()
+        .enumerate()
+        .map(|(k, &start)| {
+            let end = cuts.get(k + 1).copied().unwrap_or(length);
+            Piece { start_m: start, length_m: end - start, fixed: fixed(start), joint_span_m: 0.0 }
+        })
+        .collect();
+    for k in 0..pieces.len() {
+        let flex = |p: &Piece| if p.fixed { 0.0 } else { p.length_m / 2.0 };
+        let before = if k == 0 { flex(&pieces[0]) } else { flex(&pieces[k - 1]) };
+        pieces[k].joint_span_m = before + flex(&pieces[k]);
+    }
+    pieces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fixed_pieces_are_the_same_at_any_number_of_links() {
+        for n in [8, 16, 32, 64, 128] {
+            let f = FingerConfig { segments: n, ..FingerConfig::default() };
+            let pieces = layout(&f);
+            let total: f64 = pieces.iter().map(|p| p.length_m).sum();
+            assert!((total - f.length_m).abs() < 1e-12, "{n}: {total}");
+            let fixed: Vec<(f64, f64)> = pieces.iter().filter(|p| p.fixed).map(|p| (p.start_m, p.length_m)).collect();
+            assert_eq!(fixed.len(), 2, "{n}");
+            assert!((fixed[0].1 - 2.0 * PAD_HALF_LENGTH_M).abs() < 1e-12);
+            assert!((fixed[0].0 - (f.pad_position_m - PAD_HALF_LENGTH_M)).abs() < 1e-12);
+            assert!((fixed[1].1 - TIP_LENGTH_M).abs() < 1e-12);
+            let l = f.segment_length_m();
+            for p in pieces.iter().filter(|p| !p.fixed) {
+                assert!(p.length_m >= l / 2.0 - 1e-12 && p.length_m < 1.5 * l + 1e-12, "{n}: {p:?}");
+            }
+        }
+    }
+}
