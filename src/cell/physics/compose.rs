@@ -160,7 +160,10 @@ pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, Physics
     }
     let curl_terms: String = (0..pieces.len())
         .filter(|&i| bends(&pieces[i]))
-        .map(|i| format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(f.moment_arm_m)))
+        .map(|i| {
+            let arm = f.moment_arm_m * (-f.tendon_tension_decay_per_m * pieces[i].start_m).exp();
+            format!("<joint joint=\"curl{i}\" coef=\"{}\"/>\n      ", num(per_joint(arm)))
+        })
         .collect();
     let k = f.tendon_stiffness_n_m;
     let k_elastic = f.relaxed_fraction * k;

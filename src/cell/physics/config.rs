@@ -199,9 +199,11 @@ pub struct PhysicsConfig {
     pub noslip_iterations: u32,
     /// No-slip solver tolerance.
     pub noslip_tolerance: f64,
-    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 0.01 s: two steps at the
-    /// default step (MuJoCo's minimum; it clamps shorter ones); with the finger's armature the strip
-    /// sinks about 1 mm into the objects.
+    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 0.02 s: four steps at
+    /// the default 5 ms step, so the contact dynamics are resolved by the integrator instead of being
+    /// clamped to MuJoCo's two-step minimum; at 0.01 s (two steps) the crimper's rise and fluctuation
+    /// moved with the timestep (README, "Convergence"). With the finger's armature the strip sinks
+    /// about 1 mm into the objects.
     pub contact_timeconst_s: f64,
     /// Contact solref damping ratio (1 = critical).
     pub contact_dampratio: f64,
@@ -235,7 +237,7 @@ impl Default for PhysicsConfig {
             ls_iterations: 20,
             noslip_iterations: 10,
             noslip_tolerance: 1e-8,
-            contact_timeconst_s: 0.01,
+            contact_timeconst_s: 0.02,
             contact_dampratio: 1.0,
             contact_solimp: [0.95, 0.99, 0.001],
             arm_mode: ArmMode::Kinematic,
@@ -294,9 +296,10 @@ impl Validate for PhysicsConfig {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FingerConfig {
-    /// Number of strip segments (discretisation). 8: 17.5 mm segments, the 12 mm pad fits on one and a
-    /// 12.5 mm-radius handle is wrapped by ~4.5 segments per turn. 12 or 16 did not change the pad's
-    /// share of the force and cost speed.
+    /// Number of strip segments (discretisation; the pad's casing and the tip's anchor are single
+    /// rigid pieces at any number, `strip::layout`). 32: 4.4 mm links, about 19 per turn around a
+    /// 12.5 mm-radius handle, the coarsest finger whose answers agree with 64 links on outcome, rise
+    /// and fluctuation (README, "Convergence"; 16 links moved the drops by 1.4-2.7 s).
     pub segments: u32,
     /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
@@ -335,9 +338,24 @@ pub struct FingerConfig {
     pub bending_armature_kg_m3: f64,
     /// Tendon offset from the strip's neutral axis \[m\] (moment arm of the tendon on each joint). 3 mm.
     pub moment_arm_m: f64,
+    /// How fast the tendon's tension falls along the strip through friction in its channel [1/m]:
+    /// T(s) = T0 exp(-this * s) at arc length s from the base, so each joint's moment arm in the
+    /// tendon is `moment_arm_m * exp(-this * s_joint)`. A capstan law in arc length: channel
+    /// friction μ on a wrap of radius R gives this = μ / R. 0: no friction (the bending moment is the
+    /// same everywhere, and the strip presses the object only where the wrap starts, at the pad and
+    /// at the tip). 25 /m: μ ≈ 0.34 on the 13.5 mm radius of the strip around a 12.5 mm handle, a
+    /// stated choice for a polymer tendon in a printed TPU channel (polymer on TPU, 0.3-0.5). With
+    /// it the strip presses along the whole wrap, as a falling moment must (p = -d²M/ds² where it
+    /// conforms), and the pad's force converges with the links (quasi-static wrap, 25 mm of tendon:
+    /// 2.22 / 2.17 / 2.18 / 2.22 N at 16 / 32 / 64 / 128 links); without it the pad sat where the wrap
+    /// lifts off and touched with its casing's edge (0.5 / 1.7 / 1.8 / 2.3 N). models/README.md,
+    /// "The finger as a discretised strip".
+    pub tendon_tension_decay_per_m: f64,
     /// Instantaneous tendon-path stiffness K [N/m] (both SLS branches in parallel): tendon plus the soft
-    /// material it pulls on; sets how fast grip grows with twine. Tuned: 3000 (was 2000) with the spool
-    /// radius so the paper's Kp brings the pad to 90 % of the setpoint within 5 s on the stiffer strip.
+    /// material it pulls on; sets how fast grip grows with twine. Tuned: 6000, so that the paper's Kp
+    /// brings the pad to 90 % of the setpoint within 5 s (1.1-1.5 s on the three objects): with 3000
+    /// the creep of the wound tendon took the motor's whole proportional speed and the crimper's and
+    /// the shampoo's estimates settled 8-10 % below the setpoint.
     pub tendon_stiffness_n_m: f64,
     /// Relaxed fraction f of the standard linear solid: after creep the stiffness is f K [-].
     /// Tuned, with `relaxation_time_s`, so that with the motor frozen at the lift the grip decays
@@ -364,13 +382,10 @@ pub struct FingerConfig {
     /// Largest twine (tendon wound in) \[m\].
     pub twine_max_m: f64,
     /// Distance of the sensor pad's centre from the strip's base \[m\] (on the sleeve, near the guide,
-    /// paper Sec. V). 43.75 mm: inside the wrap of a 12-14 mm radius handle or neck, and the middle of
-    /// the third of 8 segments: a flat segment touches a round handle at its middle, so a pad there is
-    /// loaded steadily (a pad over a joint was loaded erratically). Keep it mid-segment when changing
-    /// `segments`. Tuned: 61.25 mm, the middle of the fourth segment, near the end of the first turn
-    /// around a 12-14 mm radius handle, so that, as in the paper's setpoints, the pad takes 15-25 % of
-    /// the hand's normal force on all three objects (43.75 mm gave 13-45 %, varying with the object
-    /// and the wrap).
+    /// paper Sec. V). 61.25 mm (a choice kept from the first calibration): near the end of the first
+    /// turn around a 12-14 mm radius handle, where the pad takes 15-30 % of the strip's normal force
+    /// (nearer the base, where the wrap starts, it took 50-60 %, more than the paper's setpoints allow
+    /// on its objects). The pad's casing is one rigid piece wherever it sits (`strip::layout`).
     pub pad_position_m: f64,
     /// Rise of the strip per metre along it (dimensionless): the real strip twines as a helix, so its
     /// second turn lies above the first instead of wedging between the first turn and the object.
@@ -378,11 +393,11 @@ pub struct FingerConfig {
     /// 0.27: one turn around a 13 mm radius handle (82 mm of strip) rises by the strip's width plus 2 mm.
     pub helix_slope: f64,
     /// Height of the pad's bump tip above the strip's inner face \[m\]. The casing is 4 mm tall and the
-    /// bump 1.5 mm (5.5 mm in all) but how deep the casing sits in the sleeve is not published: this sets
-    /// how much of the wrap's force the pad takes. Tunable; 2.5 mm (casing 3 mm recessed) gives the pad
-    /// ~20-25 % of the strip's normal force (5.5 mm: 30-45 %). The paper's setpoints (0.6-1.6 N on the
-    /// pad for objects needing 4-8 N of normal force at their friction) suggest 10-20 %.
-    /// Tuned with `pad_position_m`: 3 mm (casing 2.5 mm recessed) gives 15-25 % on the three objects.
+    /// bump 1.5 mm (5.5 mm in all); how deep the casing sits in the sleeve is not published, and this
+    /// sets how much of the wrap's force the pad takes.
+    /// 5.5 mm: the casing stands on the sleeve, not recessed (4 mm casing, Sec. II-A, plus the
+    /// assumed 1.5 mm bump); with the tendon's friction (`tendon_tension_decay_per_m`) the pad then
+    /// takes 15-30 % of the strip's normal force on the crimper, as the paper's setpoints need.
     pub pad_protrusion_m: f64,
     /// Distance below the flange at which the strip leaves the guide \[m\] (hand length). A choice.
     pub exit_z_m: f64,
@@ -391,7 +406,7 @@ pub struct FingerConfig {
 impl Default for FingerConfig {
     fn default() -> Self {
         FingerConfig {
-            segments: 8,
+            segments: 32,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,
@@ -400,7 +415,8 @@ impl Default for FingerConfig {
             bending_damping_n_m2_s: 3.5e-6,
             bending_armature_kg_m3: 1.75e-6,
             moment_arm_m: 0.003,
-            tendon_stiffness_n_m: 3000.0,
+            tendon_tension_decay_per_m: 25.0,
+            tendon_stiffness_n_m: 6000.0,
             relaxed_fraction: 0.05,
             relaxation_time_s: 15.0,
             motor_armature_kg: 2.0,
@@ -409,7 +425,7 @@ impl Default for FingerConfig {
             motor_max_speed_m_s: 0.047,
             twine_max_m: 0.06,
             pad_position_m: 0.06125,
-            pad_protrusion_m: 0.003,
+            pad_protrusion_m: 0.0055,
             helix_slope: 0.27,
             exit_z_m: 0.1,
         }
@@ -438,6 +454,8 @@ impl Validate for FingerConfig {
         at.non_negative("bending_damping_n_m2_s", self.bending_damping_n_m2_s);
         at.non_negative("bending_armature_kg_m3", self.bending_armature_kg_m3);
         at.positive("moment_arm_m", self.moment_arm_m);
+        // 100 /m: the tension falls to e^-14 over the 14 cm strip; more leaves the tip unbent.
+        at.in_range("tendon_tension_decay_per_m", self.tendon_tension_decay_per_m, 0.0, 100.0);
         at.positive("tendon_stiffness_n_m", self.tendon_stiffness_n_m);
         at.in_range("relaxed_fraction", self.relaxed_fraction, 0.0, 1.0);
         at.positive("relaxation_time_s", self.relaxation_time_s);
