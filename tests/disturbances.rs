@@ -1,5 +1,5 @@
 //! `[disturbance]` and `task.minimum_durations` on the twin: each does something measurable on the
-//! short grasp-hold-lift (scenarios/short-lift.toml, ≈ 16 s of cell time, under a second of wall
+//! short grasp-hold-lift (scenarios/short-lift.toml, ≈ 12 s of cell time, about a second of wall
 //! time), leaves the run untouched before it starts, and bad values are refused by key.
 
 mod common;
@@ -57,10 +57,10 @@ fn a_push_at_a_time_starts_then() {
     let calm = run(&[]);
     let pushed = run(&[
         "disturbance.push.impulse_n_s=0.05",
-        "disturbance.push.time_s=14.0",
+        "disturbance.push.time_s=10.0",
         "disturbance.push.direction_deg=90.0",
     ]);
-    same_until(&calm.rows, &pushed.rows, 14.005);
+    same_until(&calm.rows, &pushed.rows, 10.005);
     let differs = calm.rows.iter().zip(&pushed.rows).any(|(a, b)| a.true_force_n != b.true_force_n);
     assert!(differs, "a 0.05 N·s push changed nothing");
 }
@@ -74,7 +74,9 @@ fn a_dropout_holds_the_estimate_flat_for_the_gap() {
         "disturbance.dropout.offset_s=1.0",
     ]);
     let start = phase_start(&calm.rows, Phase::Grasp) + 1.0;
-    same_until(&calm.rows, &gap.rows, start + 0.005);
+    // Up to the tick before the onset: whether the onset tick itself still got a sample depends on
+    // how the phase's start time and the offset round (both are sums of 10 ms ticks).
+    same_until(&calm.rows, &gap.rows, start - 0.005);
     let held: Vec<&TraceRow> =
         gap.rows.iter().filter(|r| r.time_s > start - 0.005 && r.time_s < start + 0.5 - 0.005).collect();
     // The tick at the onset still got the sample of the step before it; the 49 after it hold it.
@@ -85,7 +87,8 @@ fn a_dropout_holds_the_estimate_flat_for_the_gap() {
     );
     // The true force did move meanwhile (the grasp is rising), so the hold is the sensor's.
     assert!(held.iter().any(|r| r.true_force_n != held[0].true_force_n));
-    assert_eq!(gap.dropped_samples, 50, "ticks without a new sample");
+    // 0.5 s at 100 Hz: 50 ticks, or 49 when the onset tick rounds to the sample before it (above).
+    assert!((49..=50).contains(&gap.dropped_samples), "ticks without a new sample: {}", gap.dropped_samples);
     assert_eq!(gap.invalid_samples, 0, "a missing sample is not an invalid one");
     assert_eq!(calm.dropped_samples, 0);
     // After the gap the estimate moves again.

@@ -22,8 +22,7 @@ const DOWEL: &str = r#"<mujoco model="dowel">
 </mujoco>
 "#;
 
-const SCENARIO: &str = "name = \"dowel\"\nsetpoint_n = 0.8\n[object]\nfile = \"objects/dowel.xml\"\n\
-                        [physics]\nmax_penetration_m = 0.015\n";
+const SCENARIO: &str = "name = \"dowel\"\nsetpoint_n = 0.8\n[object]\nfile = \"objects/dowel.xml\"\n";
 
 /// A lab folder: `scenario.toml` and `objects/dowel.xml` (with `object` replaced as given).
 fn lab(object: &str) -> tempfile::TempDir {

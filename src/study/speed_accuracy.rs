@@ -37,9 +37,9 @@ impl Grid {
             timesteps_s: vec![0.001, 0.002, 0.005, 0.01],
             integrators: vec!["euler", "implicitfast", "implicit", "rk4"],
             cones: vec!["pyramidal", "elliptic"],
-            segments: vec![6, 8, 12],
+            segments: vec![16, 32, 64],
             rapier_iterations: vec![4, 8],
-            reference: (0.0005, 16),
+            reference: (0.00125, 64),
         }
     }
 
@@ -49,9 +49,9 @@ impl Grid {
             timesteps_s: vec![0.002, 0.005],
             integrators: vec!["implicitfast", "euler"],
             cones: vec!["elliptic"],
-            segments: vec![8],
+            segments: vec![16],
             rapier_iterations: vec![8],
-            reference: (0.001, 12),
+            reference: (0.0025, 32),
         }
     }
 }

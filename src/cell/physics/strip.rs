@@ -2,12 +2,10 @@
 //! finger as a discretised strip").
 //!
 //! The strip is flexible except for two pieces of fixed physical size: the sensor pad's rigid
-//! 12 mm casing and the tendon's anchor at the tip. A tendon pulled along a strip bends it by the
-//! same moment everywhere, so the strip bears on the object only where that moment changes: at
-//! the tip (where the tendon ends), at the pad (which stands proud) and where the wrap begins. The
-//! forces there are set by the size of those pieces, so the pieces must be the same at any number
-//! of links: their edges are joints, and the uniform grid of `finger.segments` links cuts only the
-//! flexible stretches between them.
+//! 12 mm casing and the tendon's anchor at the tip. The loads the wrap puts on the object change
+//! fastest at those pieces' edges, so their size must not change with the discretisation: their
+//! edges are joints at any number of links, and the uniform grid of `finger.segments` links cuts
+//! only the flexible stretches between them.
 
 use super::config::FingerConfig;
 
