@@ -87,3 +87,47 @@ fn dynamixel_sdk_pings_model_321_and_moves_the_growth_motor() {
     assert!((present - goal).abs() <= 20, "present {present}, goal {goal}: {v}");
     assert!((twin.motors_rad[0] - 300.0 * std::f64::consts::TAU / 4096.0).abs() < 0.05, "{twin:?}");
 }
+
+#[test]
+fn dynamixel_sdk_gets_the_manuals_status_errors_and_syncs_and_bulk_reads_the_moving_pair() {
+    let _turn = one_at_a_time();
+    let Some(python) = python() else { return };
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39760)).unwrap();
+    let pty = serve.pty_path.to_string_lossy().to_string();
+    let v = run_script(&python, "dynamixel_sdk_bus.py", &[&pty]);
+    let (twin, tension) = {
+        let s = serve.state.lock().unwrap();
+        (s.status, s.bus.table(2).unwrap().u16_at(126) as i16)
+    };
+    serve.stop().unwrap();
+    eprintln!("{v}");
+    // The e-manual's status errors, as dynamixel-sdk decodes them.
+    assert_eq!(v["velocity_limit"], 360, "the control table's default");
+    assert_eq!(v["data_length"], 5, "2 bytes to the 4-byte Goal Position");
+    assert_eq!(v["range_goal"], 4, "Goal Position 5000 in position mode");
+    assert_eq!(v["range_mode"], 4, "Operating Mode 9");
+    assert_eq!(v["access_read_only"], 7, "Present Position is read-only");
+    assert_eq!(v["access_undefined"], 7, "address 200 is not in the table");
+    assert_eq!(v["crc"], 3, "a wrong CRC");
+    assert_eq!(v["goal_after_errors"], v["goal_before_errors"], "no failed write changed Goal Position");
+    // Sync write moved both motors most of the way (the twine motor against the tendon's pull,
+    // which may stall it short of its goal, as on the real finger); sync read sees them there.
+    for id in ["1", "2"] {
+        let (goal, present) = (v["goals"][id].as_i64().unwrap(), v["present"][id].as_i64().unwrap());
+        assert!(present > goal * 8 / 10 && present <= goal + 10, "ID {id}: present {present}, goal {goal}: {v}");
+    }
+    // Bulk read saw them move: Present Velocity from the motion, Moving set on the way.
+    for id in ["1", "2"] {
+        assert!(v["max_velocity"][id].as_i64().unwrap() > 10, "ID {id} never reported a velocity: {v}");
+    }
+    assert_eq!(v["moving_seen"], true, "{v}");
+    // Present Current of the twine motor is the tendon's load through gear and torque constant.
+    let current = v["twine_current"].as_i64().unwrap();
+    assert!(current >= 0, "the tendon pulls against the winding direction: {v}");
+    assert!((current - i64::from(tension)).abs() <= 20, "last read {current}, table now {tension}: {v}");
+    assert!(twine_rad_matches(&twin, v["present"]["2"].as_i64().unwrap()), "{twin:?} {v}");
+}
+
+fn twine_rad_matches(twin: &tendril::cell::real::serve::TwinStatus, ticks: i64) -> bool {
+    (twin.motors_rad[1] - ticks as f64 * std::f64::consts::TAU / 4096.0).abs() < 0.05
+}

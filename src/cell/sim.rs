@@ -88,6 +88,17 @@ impl SimCell {
         Ok(())
     }
 
+    /// Tendon tension after the last step \[N\] (both branches): the twine motor's load, which
+    /// the virtual MX-106 reports as Present Current. 0 before activation.
+    pub fn tendon_tension_n(&self) -> f64 {
+        self.readout.tendon_tension_n
+    }
+
+    /// Radius of the twine spool \[m\]: the lever the tendon tension acts on at the twine motor.
+    pub fn twine_spool_radius_m(&self) -> f64 {
+        self.gripper.twine_spool_radius_m
+    }
+
     /// A cell over a compiled scene model (shareable between runs). Nothing is simulated until
     /// [`Cell::configure`].
     pub fn new(

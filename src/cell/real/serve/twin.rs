@@ -4,8 +4,10 @@ use super::pose::tcp_pose;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
-use crate::cell::real::protocol::dynamixel::units::{baud_rate_code, rad_to_ticks, ticks_to_rad};
-use crate::cell::real::protocol::dynamixel::{StreamDecoder, VirtualBus};
+use crate::cell::real::protocol::dynamixel::units::{
+    baud_rate_code, present_current_units, present_velocity_units, rad_to_ticks, ticks_to_rad,
+};
+use crate::cell::real::protocol::dynamixel::{ControlTable, StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
 use crate::cell::real::protocol::rtde::state::{
     RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
@@ -126,6 +128,21 @@ fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
     state.lock().unwrap_or_else(|p| p.into_inner())
 }
 
+/// Writes what an MX-106's sensors would measure into its table: Present Position, Present
+/// Velocity and Moving from the motion, Present Current from the load on the output shaft (through
+/// the gear ratio and torque constant, [`present_current_units`]).
+fn present_motion(table: &mut ControlTable, rad: f64, rad_s: f64, torque_nm: f64) {
+    if let Ok(ticks) = rad_to_ticks(rad) {
+        table.set_present_position(ticks);
+    }
+    let velocity = present_velocity_units(rad_s);
+    table.set_present_velocity(velocity);
+    let threshold = table.u32_at(addr::MOVING_THRESHOLD);
+    table.set_moving(velocity.unsigned_abs() > threshold);
+    let limit = table.u16_at(addr::CURRENT_LIMIT);
+    table.set_present_current(present_current_units(torque_nm, limit));
+}
+
 /// Opens the pseudo-terminal pair and serves the bus on its master side until `stop`.
 pub fn open_bus(
     state: Arc<Mutex<DeviceState>>,
@@ -188,8 +205,10 @@ pub fn spawn(
         // The physics moves the arm once per step (several twin ticks): the joint velocities are
         // the last step's displacement over its duration (the kinematic arm moves at a constant
         // rate within a step), held until the next step changes them.
-        let mut last_step = (first.time_s, first.arm_q);
+        let mut last_step = (first.time_s, first.arm_q, [first.growth_motor_rad, first.twine_motor_rad]);
         let mut actual_qd = [0.0; ARM_JOINTS];
+        // The motors' speeds, the same way (Present Velocity).
+        let mut motor_rad_s = [0.0; 2];
         let mut measured_q = first.arm_q;
         // The program's RTDE watchdog once armed: the watched input's write count and when it last
         // changed (twin time, so a twin held up by a lock never counts as a silent client).
@@ -291,11 +310,16 @@ pub fn spawn(
             cell.wait_until(k as f64 * period_s).map_err(e)?;
             let r = cell.read().map_err(e)?;
             let truth = cell.ground_truth().unwrap_or_default();
+            let motors_rad = [r.growth_motor_rad, r.twine_motor_rad];
             if r.time_s > last_step.0 + 1e-12 {
                 let dt = r.time_s - last_step.0;
                 actual_qd = std::array::from_fn(|j| (r.arm_q[j] - last_step.1[j]) / dt);
-                last_step = (r.time_s, r.arm_q);
+                motor_rad_s = std::array::from_fn(|m| (motors_rad[m] - last_step.2[m]) / dt);
+                last_step = (r.time_s, r.arm_q, motors_rad);
             }
+            // The load on each motor's output shaft: the tendon's tension on the twine spool; the
+            // growth motor's load is not modelled (0).
+            let motor_torque_nm = [0.0, cell.tendon_tension_n() * cell.twine_spool_radius_m()];
             measured_q = r.arm_q;
             {
                 let mut s = lock(&state);
@@ -318,9 +342,9 @@ pub fn spawn(
                 o.actual_tcp_pose = tcp_pose(&r.arm_q, &o.tcp_offset);
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
                 o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
-                for (id, rad) in motors.into_iter().zip([r.growth_motor_rad, r.twine_motor_rad]) {
-                    if let (Some(t), Ok(ticks)) = (s.bus.table_mut(id), rad_to_ticks(rad)) {
-                        t.set_present_position(ticks);
+                for (m, id) in motors.into_iter().enumerate() {
+                    if let Some(t) = s.bus.table_mut(id) {
+                        present_motion(t, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
                     }
                 }
                 let nanos = (r.time_s.fract() * 1e9) as u32;
