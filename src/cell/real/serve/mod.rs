@@ -10,9 +10,11 @@
 //! - Dynamixel: two MX-106 at the scenario's `hardware.growth_id` and `hardware.twine_id` (1, 2 by
 //!   default) on a pseudo-terminal (its path in [`ServeHandle::pty_path`]); Goal Position drives
 //!   the twin's motors, Present Position reports them; Baud Rate reads `hardware.dxl_baud`.
-//! - HYPERION: commands on `command_port` (51971), one peak frame per twin tick on `stream_port`
-//!   (51972); FBG1 and FBG2 on channel `hardware.fbg.channel`, at the wavelengths the twin's
-//!   sensor model gives.
+//! - HYPERION: commands on `command_port` (51971), one scan per twin tick (a new interrogator
+//!   sample each, the pad force held between physics steps), every scan streamed on `stream_port`
+//!   (51972) to a reader that keeps up (serial numbers consecutive; every n-th with the streaming
+//!   divider); FBG1 and FBG2 on channel `hardware.fbg.channel`, at the wavelengths the twin's
+//!   sensor model gives; `#GetSpectrum` draws them with the scenario's spectral line model.
 //!
 //! Malformed input: RTDE and HYPERION connections are closed on a framing error (after the
 //! device's error reply where the protocol has one); the bus drops corrupt packets as a device does.
@@ -145,7 +147,7 @@ pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Resu
     anyhow::ensure!(config.period_s > 0.0 && config.period_s <= 0.01, "twin period must be in (0, 10 ms]");
     let stop = Arc::new(AtomicBool::new(false));
     let hardware = scenario.hardware;
-    let (state, ticks) = twin::shared_state(&hardware)?;
+    let (state, ticks) = twin::shared_state(&hardware, &scenario.interrogator.spectral)?;
     let rt = config.realtime;
     // Fail early and clearly rather than in each thread.
     let probe = std::thread::spawn(move || rt.apply_to_current_thread());

@@ -188,21 +188,19 @@ async fn serve_commands(mut socket: TcpStream, state: Shared, idle: Duration) {
     }
 }
 
-/// HYPERION peak stream: the latest frame after each twin tick (a slow reader skips frames,
-/// which its serial-number check reports).
+/// HYPERION peak stream: after each twin tick, every scan since the last one sent (a reader that
+/// keeps up gets consecutive serial numbers; one more than the backlog behind loses the oldest).
 async fn serve_stream(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>) {
+    let mut sent = None;
     while ticks.changed().await.is_ok() {
-        let frame = {
+        let bytes = {
             let s = lock(&state);
-            let (on, _) = s.interrogator.streaming();
-            if !on {
-                continue;
-            }
-            s.interrogator.stream_frame()
+            s.interrogator.stream_after(sent)
         };
-        match frame {
-            Ok(bytes) => {
-                if socket.write_all(&bytes).await.is_err() {
+        match bytes {
+            Ok((bytes, last)) => {
+                sent = last;
+                if !bytes.is_empty() && socket.write_all(&bytes).await.is_err() {
                     return;
                 }
             }

@@ -1,6 +1,7 @@
 //! The twin thread (SimCell in real time) and the Dynamixel bus on a pseudo-terminal.
 
 use super::pose::tcp_pose;
+use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
@@ -92,9 +93,11 @@ pub struct DeviceState {
 }
 
 /// The shared state and the tick channel (the twin sends its tick count after each update): the
-/// motors at `hardware`'s IDs and bus speed, an interrogator with enough channels for its FBG channel.
+/// motors at `hardware`'s IDs and bus speed, an interrogator with enough channels for its FBG
+/// channel, whose `#GetSpectrum` draws lines as `spectral` describes them.
 pub fn shared_state(
     hardware: &HardwareConfig,
+    spectral: &SpectralConfig,
 ) -> anyhow::Result<(Arc<Mutex<DeviceState>>, tokio::sync::watch::Sender<u64>)> {
     let mut bus = VirtualBus::with_ids(&hardware.motor_ids()).map_err(|e| anyhow::anyhow!("virtual bus: {e}"))?;
     let baud = baud_rate_code(hardware.dxl_baud)
@@ -107,8 +110,12 @@ pub fn shared_state(
     // The si255 has 1, 4, 8 or 16 channels: the virtual one keeps its default 4 unless the FBG
     // channel needs more.
     let channel_count = [4, 8, 16].into_iter().find(|&n| n >= hardware.fbg.channel).unwrap_or(16) as u32;
-    let interrogator = VirtualInterrogator::new(InterrogatorConfig { channel_count, ..InterrogatorConfig::default() })
-        .map_err(|e| anyhow::anyhow!("virtual interrogator: {e}"))?;
+    let interrogator = VirtualInterrogator::new(InterrogatorConfig {
+        channel_count,
+        spectral: spectral.clone(),
+        ..InterrogatorConfig::default()
+    })
+    .map_err(|e| anyhow::anyhow!("virtual interrogator: {e}"))?;
     let state = DeviceState {
         outputs: RobotOutputs::default(),
         inputs: SharedInputs::new(),
@@ -193,6 +200,9 @@ pub fn spawn(
         let _ = realtime.apply_to_current_thread();
         // Built here: the simulation's data stays on this thread.
         let mut cell = SimCell::for_scenario(&scenario, model);
+        // A new interrogator sample every tick (one scan period at the default 1 ms), not only when
+        // the physics steps: the peak stream then carries a new sample in each frame.
+        cell.sample_every_wait();
         let e = |e: crate::hardware::CellError| e.to_string();
         cell.configure().map_err(e)?;
         cell.activate().map_err(e)?;
@@ -347,12 +357,13 @@ pub fn spawn(
                         present_motion(t, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
                     }
                 }
-                let nanos = (r.time_s.fract() * 1e9) as u32;
+                // Scan k, stamped with its twin time (the physics may lag it by part of a step).
+                let scan_s = k as f64 * period_s;
                 let frame = PeakFrame {
                     header: PeakHeader {
                         serial_number: k,
-                        timestamp_s: r.time_s as u32,
-                        timestamp_ns: nanos,
+                        timestamp_s: scan_s as u32,
+                        timestamp_ns: (scan_s.fract() * 1e9) as u32,
                         ..PeakHeader::default()
                     },
                     channels: (1..=channel)
