@@ -1,6 +1,7 @@
 //! Independent clients from PyPI against the virtual devices: SDU `ur_rtde` reads `actual_q`
-//! from the virtual UR5e, ROBOTIS `dynamixel-sdk` pings the virtual MX-106 and writes/reads Goal
-//! and Present Position over the pseudo-terminal.
+//! from the virtual UR5e and drives its dashboard server, ROBOTIS `dynamixel-sdk` pings the virtual
+//! MX-106, writes/reads Goal and Present Position over the pseudo-terminal, gets the e-manual's
+//! status errors and sync/bulk reads the pair.
 //!
 //! `cargo xtask test` installs both (pinned) in `vendor/venv` and sets `TENDRIL_PYTHON`; under a
 //! plain `cargo test` these tests say loudly that they are skipped.
@@ -130,4 +131,28 @@ fn dynamixel_sdk_gets_the_manuals_status_errors_and_syncs_and_bulk_reads_the_mov
 
 fn twine_rad_matches(twin: &tendril::cell::real::serve::TwinStatus, ticks: i64) -> bool {
     (twin.motors_rad[1] - ticks as f64 * std::f64::consts::TAU / 4096.0).abs() < 0.05
+}
+
+#[test]
+fn ur_rtde_dashboard_client_drives_the_virtual_dashboard_server() {
+    let _turn = one_at_a_time();
+    let Some(python) = python() else { return };
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39870)).unwrap();
+    let addr = serve.ur_addrs.dashboard;
+    let v = run_script(&python, "ur_rtde_dashboard.py", &[&addr.ip().to_string(), &addr.port().to_string()]);
+    let program = serve.state.lock().unwrap().program;
+    serve.stop().unwrap();
+    assert_eq!(v["connected"], true);
+    assert_eq!(v["remote"], true, "ur_rtde asks only on PolyScope 5.6 and later: {v}");
+    assert_eq!(v["version"], "5.11.1.108318");
+    assert_eq!(v["robotmode"], "Robotmode: RUNNING");
+    assert_eq!(v["safetystatus"], "Safetystatus: NORMAL");
+    assert_eq!(v["after_power_off"], "Robotmode: POWER_OFF");
+    assert_eq!(v["after_power_on"], "Robotmode: IDLE");
+    assert_eq!(v["after_brake_release"], "Robotmode: RUNNING");
+    assert_eq!(v["running"], true);
+    assert_eq!(v["program_state"], "PLAYING /programs/follow.urp");
+    assert_eq!(v["paused_state"], "PAUSED /programs/follow.urp");
+    assert_eq!(v["running_after_stop"], false);
+    assert_eq!(program, tendril::cell::real::serve::ProgramState::Stopped);
 }

@@ -80,11 +80,11 @@ impl DeviceArgs {
     }
 }
 
-/// Parses `--port-base N`: four ports N..N+3 must fit below 65536.
+/// Parses `--port-base N`: six ports N..N+5 must fit below 65536.
 pub fn port_base(text: &str) -> Result<u16, String> {
     let base: u16 = text.parse().map_err(|e| format!("{e}"))?;
-    if base == 0 || base > u16::MAX - 3 {
-        return Err(format!("must be 1-{} (ports N..N+3)", u16::MAX - 3));
+    if base == 0 || base > u16::MAX - 5 {
+        return Err(format!("must be 1-{} (ports N..N+5)", u16::MAX - 5));
     }
     Ok(base)
 }

@@ -106,7 +106,7 @@ for dxl_id in (1, 2):
     assert sync_read.addParam(dxl_id)
 max_velocity = {1: 0, 2: 0}
 moving_seen = False
-still = 0
+still_since = None
 present = dict(start)
 deadline = time.time() + 10.0
 while time.time() < deadline:
@@ -125,11 +125,17 @@ while time.time() < deadline:
     if res != COMM_SUCCESS:
         raise SystemExit(f"sync read: {ph.getTxRxResult(res)}")
     present = {i: s32(sync_read.getData(i, 132, 4)) for i in (1, 2)}
-    # Done once both have moved and then stood still for a while (a loaded motor may stall
-    # short of its goal, as a real one does).
-    still = still + 1 if (v1, v2) == (0, 0) and min(max_velocity.values()) > 0 else 0
-    if still >= 10:
-        break
+    # Done once both have moved and then stood still for 300 ms of the device's own time
+    # (Realtime Tick: a twin held up by a loaded machine does not count); a loaded motor may stall
+    # short of its goal, as a real one does.
+    tick, res, err = retry(ph.read2ByteTxRx, port, 2, 120)
+    ok(res, err, "read realtime tick")
+    if (v1, v2) == (0, 0) and min(max_velocity.values()) > 0:
+        still_since = tick if still_since is None else still_since
+        if (tick - still_since) % 32768 >= 300:
+            break
+    else:
+        still_since = None
     time.sleep(0.01)
 port.closePort()
 out.update(

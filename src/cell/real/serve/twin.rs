@@ -1,9 +1,11 @@
 //! The twin thread (SimCell in real time) and the Dynamixel bus on a pseudo-terminal.
 
+use super::dashboard::{UrController, VirtualUrSetup};
 use super::pose::tcp_pose;
 use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
+use crate::cell::real::protocol::dashboard::RobotMode;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
 use crate::cell::real::protocol::dynamixel::units::{
     baud_rate_code, present_current_units, present_velocity_units, rad_to_ticks, ticks_to_rad,
@@ -79,9 +81,11 @@ pub struct DeviceState {
     pub watchdog: Option<RtdeWatchdog>,
     /// Programs uploaded so far (each upload restarts the program and its watchdog).
     pub program_uploads: u64,
-    /// Why the arm is in a protective stop, if it is (cleared by a fresh program upload: the
-    /// virtual UR has no dashboard server to unlock it with).
+    /// Why the arm is in a protective stop, if it is (cleared by `unlock protective stop` on the
+    /// dashboard, or by a fresh program upload).
     pub protective_stop: Option<String>,
+    /// Robot mode, remote control, PolyScope version, loaded program ([`super::dashboard`]).
+    pub ur: UrController,
     /// The MX-106 pair.
     pub bus: VirtualBus,
     /// The interrogator.
@@ -98,6 +102,7 @@ pub struct DeviceState {
 pub fn shared_state(
     hardware: &HardwareConfig,
     spectral: &SpectralConfig,
+    ur: &VirtualUrSetup,
 ) -> anyhow::Result<(Arc<Mutex<DeviceState>>, tokio::sync::watch::Sender<u64>)> {
     let mut bus = VirtualBus::with_ids(&hardware.motor_ids()).map_err(|e| anyhow::anyhow!("virtual bus: {e}"))?;
     let baud = baud_rate_code(hardware.dxl_baud)
@@ -123,6 +128,7 @@ pub fn shared_state(
         watchdog: None,
         program_uploads: 0,
         protective_stop: None,
+        ur: UrController::new(ur),
         bus,
         interrogator,
         status: TwinStatus::default(),
@@ -137,8 +143,11 @@ fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
 
 /// Writes what an MX-106's sensors would measure into its table: Present Position, Present
 /// Velocity and Moving from the motion, Present Current from the load on the output shaft (through
-/// the gear ratio and torque constant, [`present_current_units`]).
-fn present_motion(table: &mut ControlTable, rad: f64, rad_s: f64, torque_nm: f64) {
+/// the gear ratio and torque constant, [`present_current_units`]), Realtime Tick from the twin's
+/// time (milliseconds, wrapping at 32 767 as the device's does).
+fn present_motion(table: &mut ControlTable, time_s: f64, rad: f64, rad_s: f64, torque_nm: f64) {
+    let tick_ms = (time_s * 1e3).round().rem_euclid(32768.0) as u16;
+    table.put(addr::REALTIME_TICK, &tick_ms.to_le_bytes());
     if let Ok(ticks) = rad_to_ticks(rad) {
         table.set_present_position(ticks);
     }
@@ -283,6 +292,11 @@ pub fn spawn(
                         Some(_) => {}
                     }
                 }
+                // Powered off or brakes engaged (dashboard): no program runs, the arm holds.
+                if s.ur.robot_mode != RobotMode::Running && s.program != ProgramState::Stopped {
+                    s.program = ProgramState::Stopped;
+                    hold = true;
+                }
                 let mut new = false;
                 if s.program == ProgramState::Playing && enabled && arrived {
                     match super::safety::violation(&targets, &measured_q) {
@@ -293,6 +307,7 @@ pub fn spawn(
                         Some(why) => {
                             // Protective stop: the arm stops where it is, the program stops.
                             s.protective_stop = Some(why);
+                            s.ur.protective_stop_at = Some(now_s);
                             s.program = ProgramState::Stopped;
                             hold = true;
                         }
@@ -340,10 +355,12 @@ pub fn spawn(
                     ProgramState::Playing => RUNTIME_STATE_PLAYING,
                     ProgramState::Paused => RUNTIME_STATE_PAUSED,
                 };
+                let robot_mode = s.ur.robot_mode.rtde();
                 let safety_mode =
                     if s.protective_stop.is_some() { SAFETY_MODE_PROTECTIVE_STOP } else { SAFETY_MODE_NORMAL };
                 let o = &mut s.outputs;
                 o.runtime_state = runtime_state;
+                o.robot_mode = robot_mode;
                 o.safety_mode = safety_mode;
                 o.timestamp_s = r.time_s;
                 o.actual_qd = actual_qd;
@@ -354,7 +371,7 @@ pub fn spawn(
                 o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
                 for (m, id) in motors.into_iter().enumerate() {
                     if let Some(t) = s.bus.table_mut(id) {
-                        present_motion(t, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
+                        present_motion(t, r.time_s, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
                     }
                 }
                 // Scan k, stamped with its twin time (the physics may lag it by part of a step).

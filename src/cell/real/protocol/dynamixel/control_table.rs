@@ -95,6 +95,8 @@ pub mod addr {
     pub const PROFILE_VELOCITY: u16 = 112;
     /// Goal Position (4, 4096 ticks/rev).
     pub const GOAL_POSITION: u16 = 116;
+    /// Realtime Tick (2, ms, wraps at 32 767).
+    pub const REALTIME_TICK: u16 = 120;
     /// Moving (1).
     pub const MOVING: u16 = 122;
     /// Present Current (2, signed).
