@@ -22,7 +22,7 @@ pub struct DeviceArgs {
     #[arg(long, default_value = "127.0.0.1")]
     interrogator: String,
     /// Non-standard ports, as `tendril serve --port-base N` uses: RTDE N, URScript N+1,
-    /// HYPERION commands N+2, peaks N+3.
+    /// HYPERION commands N+2, peaks N+3, UR dashboard N+4.
     #[arg(long, value_parser = port_base)]
     port_base: Option<u16>,
     /// Sensor watchdog: stop when the latest peak sample is this many interrogator periods old.
