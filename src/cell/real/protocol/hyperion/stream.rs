@@ -42,10 +42,10 @@ impl ScanBacklog {
     /// divider `divider` (0 is taken as 1): those whose serial number is a multiple of it.
     pub fn to_stream(&self, sent: Option<u64>, divider: u32) -> impl Iterator<Item = &PeakFrame> {
         let divider = u64::from(divider.max(1));
-        self.scans
-            .iter()
-            .filter(move |s| sent.is_none_or(|sent| s.header.serial_number > sent))
-            .filter(move |s| s.header.serial_number.is_multiple_of(divider))
+        // Serial numbers ascend: skip the ones sent by bisection, not one by one (this runs for
+        // every stream connection on every tick, under the devices' lock).
+        let first = sent.map_or(0, |sent| self.scans.partition_point(|s| s.header.serial_number <= sent));
+        self.scans.range(first..).filter(move |s| s.header.serial_number.is_multiple_of(divider))
     }
 }
 
