@@ -27,11 +27,13 @@ out = {}
 def retry(call, *args):
     """`call(*args)`, again if no status came: on a loaded machine the virtual bus can miss the
     SDK's 34 ms reply window now and then, as a real bus can drop a packet."""
-    for _ in range(5):
+    started = time.time()
+    for attempt in range(5):
         result = call(*args)
         res = result if isinstance(result, int) else result[-2]
         if res != COMM_RX_TIMEOUT:
             return result
+        print(f"retry {attempt + 1} of {getattr(call, '__name__', call)}{args[1:]}: {res} after {time.time() - started:.3f} s", file=sys.stderr)
     return result
 
 
