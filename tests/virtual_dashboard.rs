@@ -84,6 +84,11 @@ fn the_dashboard_answers_as_the_controller_does_and_30003_takes_programs() {
     assert_eq!(d.ask("robotmode"), "Robotmode: IDLE");
     assert_eq!(d.ask("brake release"), "Brake releasing");
     assert_eq!(d.ask("robotmode"), "Robotmode: RUNNING");
+    // RTDE's robot_mode follows at the twin's next tick.
+    let deadline = Instant::now() + Duration::from_secs(2);
+    while serve.state.lock().unwrap().outputs.robot_mode != 7 && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(5));
+    }
     assert_eq!(serve.state.lock().unwrap().outputs.robot_mode, 7, "RTDE robot_mode follows");
     // A protective stop unlocks 5 s after it happened, not before.
     {
