@@ -189,13 +189,13 @@ fn a_scenario_name_cannot_write_outside_out() {
 
 #[test]
 fn serve_stops_cleanly_on_sigterm() {
-    // Four free consecutive ports: bound and released by the OS's choice of the first.
+    // Six free consecutive ports (serve takes N..N+5): bound and released by the OS's choice of the first.
     let base = (0..50)
         .find_map(|_| {
             let l = std::net::TcpListener::bind("127.0.0.1:0").ok()?;
             let p = l.local_addr().ok()?.port();
             drop(l);
-            (p < 65000 && (1..4).all(|i| std::net::TcpListener::bind(("127.0.0.1", p + i)).is_ok())).then_some(p)
+            (p < 65000 && (1..6).all(|i| std::net::TcpListener::bind(("127.0.0.1", p + i)).is_ok())).then_some(p)
         })
         .expect("free ports");
     let out = signal_after(

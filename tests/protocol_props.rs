@@ -240,3 +240,53 @@ proptest! {
         prop_assert_eq!(Request::decode(&wire), Decoded::Frame { packet: request, consumed: wire.len() });
     }
 }
+
+// ---------- New command surfaces of the virtual devices ----------
+
+/// The commands the virtual HYPERION gained for Luna's client, with arbitrary arguments.
+fn luna_command() -> impl Strategy<Value = &'static str> {
+    prop::sample::select(vec![
+        "#SetInstrumentName",
+        "#getDetectionSetting",
+        "#GetChannelDetectionSettingId",
+        "#SetChannelDetectionSettingID",
+        "#setActiveFullSpectrumDutChannelNumbers",
+        "#GetSpectrum",
+        "#SetPeakDataStreamingDivider",
+    ])
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn the_virtual_bus_survives_arbitrary_byte_streams(
+        chunks in prop::collection::vec(prop::collection::vec(prop_oneof![Just(0xFFu8), Just(0xFD), Just(0x00), any::<u8>()], 0..80), 0..8)
+    ) {
+        let mut bus = VirtualBus::with_ids(&[1, 2]).unwrap();
+        let mut decoder = StreamDecoder::new();
+        for chunk in &chunks {
+            let _ = bus.respond_to_bytes(&mut decoder, chunk);
+        }
+        prop_assert!(bus.ids().len() <= 2);
+    }
+
+    #[test]
+    fn hyperion_commands_with_arbitrary_arguments_answer_and_never_panic(
+        command in luna_command(), argument in "[ -~]{0,70}"
+    ) {
+        let mut dev = VirtualInterrogator::new(hyperion::InterrogatorConfig::default()).unwrap();
+        let reply = dev.handle(&Request::new(command, &argument));
+        prop_assert!(reply.encode().is_ok());
+        // Streaming stays consistent whatever the divider became.
+        dev.set_peaks(PeakFrame::default()).unwrap();
+        prop_assert!(dev.stream_after(None).is_ok());
+    }
+
+    #[test]
+    fn dashboard_lines_parse_without_panicking(line in "\\PC{0,60}") {
+        use tendril::cell::real::protocol::dashboard::{Command, PolyscopeVersion, RobotMode, SafetyStatus};
+        let _ = Command::parse(&line).line();
+        let _ = (RobotMode::parse_reply(&line), SafetyStatus::parse_reply(&line), PolyscopeVersion::parse_reply(&line));
+    }
+}

@@ -71,6 +71,9 @@ pub struct SimCell {
     pushing: bool,
     /// The MuJoCo states recorded for `tendril render` ([`SimCell::record_frames`]).
     frames: Option<crate::render::frames::FrameRecorder>,
+    /// Whether [`Cell::wait_until`] samples the sensor up to the time waited for rather than the
+    /// physics' time ([`SimCell::sample_every_wait`]).
+    sample_to_wait_time: bool,
 }
 
 impl SimCell {
@@ -86,6 +89,26 @@ impl SimCell {
         scene.set_growth(growth).map_err(Self::physics_error)?;
         scene.set_twine(twine).map_err(Self::physics_error)?;
         Ok(())
+    }
+
+    /// Tendon tension after the last step \[N\] (both branches): the twine motor's load, which
+    /// the virtual MX-106 reports as Present Current. 0 before activation.
+    pub fn tendon_tension_n(&self) -> f64 {
+        self.readout.tendon_tension_n
+    }
+
+    /// Radius of the twine spool \[m\]: the lever the tendon tension acts on at the twine motor.
+    pub fn twine_spool_radius_m(&self) -> f64 {
+        self.gripper.twine_spool_radius_m
+    }
+
+    /// Draws the interrogator's samples up to each time [`Cell::wait_until`] is given, holding
+    /// the pad force of the last physics step in between, rather than only up to the physics'
+    /// own time (which advances a whole step at once). For the virtual interrogator behind `tendril
+    /// serve`, whose ticks are shorter than a physics step: every tick one interrogator period long
+    /// then brings exactly one new sample. Runs (`tendril run`) do not use it.
+    pub fn sample_every_wait(&mut self) {
+        self.sample_to_wait_time = true;
     }
 
     /// A cell over a compiled scene model (shareable between runs). Nothing is simulated until
@@ -115,6 +138,7 @@ impl SimCell {
             fresh_sample: true,
             pushing: false,
             frames: None,
+            sample_to_wait_time: false,
         }
     }
 
@@ -165,13 +189,20 @@ impl SimCell {
 
     /// Samples the sensor at every interrogator instant up to the scene's time, holding the
     /// contact force of the last physics step (zero-order hold over one step).
-    fn sample_sensor(&mut self) {
+    /// With `wait_time` (see [`SimCell::sample_every_wait`]) the sampling runs up to that time.
+    fn sample_sensor(&mut self, wait_time: Option<f64>) {
         let dt = 1.0 / self.interrogator.sample_rate_hz;
         self.readout = self.scene().readout();
-        let now = self.readout.time_s;
         let force = self.readout.pad_force_n;
+        // Up to the physics' time (to 1e-12 s), or to the time waited for (the physics may have
+        // stepped past it: it steps once past the middle of a step): a quarter period's tolerance
+        // there keeps the summed sample instants' rounding from skipping or doubling one.
+        let until = match wait_time {
+            Some(t) if self.sample_to_wait_time => t + 0.25 * dt,
+            _ => self.readout.time_s + 1e-12,
+        };
         self.fresh_sample = false;
-        while self.next_sample_s <= now + 1e-12 {
+        while self.next_sample_s <= until {
             let temperature = self.environment.temperature_at(self.next_sample_s);
             // The sensor model runs through a dropout (its noise and thermal state advance); only
             // the delivery is lost. The first sample (the activation's) is always delivered.
@@ -208,7 +239,7 @@ impl Cell for SimCell {
     fn activate(&mut self) -> Result<(), CellError> {
         require_state(self.lifecycle, Lifecycle::Inactive, "activate")?;
         self.lifecycle = Lifecycle::Active;
-        self.sample_sensor();
+        self.sample_sensor(None);
         if let (Some(frames), Some(scene)) = (self.frames.as_mut(), self.scene.as_deref()) {
             frames.offer(scene);
         }
@@ -260,7 +291,7 @@ impl Cell for SimCell {
                 frames.offer(scene.as_ref());
             }
         }
-        self.sample_sensor();
+        self.sample_sensor(Some(time_s));
         Ok(())
     }
 

@@ -22,7 +22,7 @@ pub struct DeviceArgs {
     #[arg(long, default_value = "127.0.0.1")]
     interrogator: String,
     /// Non-standard ports, as `tendril serve --port-base N` uses: RTDE N, URScript N+1,
-    /// HYPERION commands N+2, peaks N+3.
+    /// HYPERION commands N+2, peaks N+3, UR dashboard N+4.
     #[arg(long, value_parser = port_base)]
     port_base: Option<u16>,
     /// Sensor watchdog: stop when the latest peak sample is this many interrogator periods old.
@@ -80,11 +80,11 @@ impl DeviceArgs {
     }
 }
 
-/// Parses `--port-base N`: four ports N..N+3 must fit below 65536.
+/// Parses `--port-base N`: six ports N..N+5 must fit below 65536.
 pub fn port_base(text: &str) -> Result<u16, String> {
     let base: u16 = text.parse().map_err(|e| format!("{e}"))?;
-    if base == 0 || base > u16::MAX - 3 {
-        return Err(format!("must be 1-{} (ports N..N+3)", u16::MAX - 3));
+    if base == 0 || base > u16::MAX - 5 {
+        return Err(format!("must be 1-{} (ports N..N+5)", u16::MAX - 5));
     }
     Ok(base)
 }

@@ -17,8 +17,9 @@ pub struct ServeArgs {
     /// Address to listen on; loopback unless asked otherwise.
     #[arg(long, default_value = "127.0.0.1")]
     bind: IpAddr,
-    /// Ports N (RTDE), N+1 (URScript), N+2 (HYPERION commands), N+3 (peaks) instead of the
-    /// devices' 30004, 30002, 51971, 51972.
+    /// Ports N (RTDE), N+1 (URScript), N+2 (HYPERION commands), N+3 (peaks), N+4 (UR dashboard),
+    /// N+5 (URScript, real-time port) instead of the devices' 30004, 30002, 51971, 51972, 29999,
+    /// 30003.
     #[arg(long, value_parser = super::devices::port_base)]
     port_base: Option<u16>,
     /// Stop after this many seconds, up to a week (default: until Ctrl-C, SIGTERM or SIGHUP).
@@ -41,9 +42,10 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     }
     let handle = start(&scenario, &config)?;
     let [rtde, script, command, stream] = handle.addrs;
+    let (dashboard, realtime_script) = (handle.ur_addrs.dashboard, handle.ur_addrs.realtime_script);
     let h = handle.hardware;
     emit(&format!(
-        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {script}\n  HYPERION  {command} (commands), {stream} (peaks; FBG1, FBG2 on channel {})\n  Dynamixel {} (MX-106 IDs {} growth, {} twine; {} bit/s)\n",
+        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {script}, {realtime_script}\n  Dashboard {dashboard}\n  HYPERION  {command} (commands), {stream} (peaks; FBG1, FBG2 on channel {})\n  Dynamixel {} (MX-106 IDs {} growth, {} twine; {} bit/s)\n",
         scenario.name,
         h.fbg.channel,
         handle.pty_path.display(),
@@ -63,7 +65,9 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
         let now = handle.state.lock().map(|s| (s.program, s.protective_stop.clone())).unwrap_or(reported.clone());
         if now != reported {
             if let Some(why) = now.1.as_ref().filter(|_| now.1 != reported.1) {
-                emit(&format!("UR5e protective stop: {why} (upload the program again to clear it)\n"));
+                emit(&format!(
+                    "UR5e protective stop: {why} (unlock it on the dashboard, or upload the program again)\n"
+                ));
             }
             if now.0 != reported.0 {
                 emit(&format!("UR5e program: {:?}\n", now.0));

@@ -15,5 +15,5 @@ mod thermal;
 
 pub use config::{InterrogatorConfig, InterrogatorMode, SensorConfig, SpectralConfig};
 pub use sensor::FbgSensor;
-pub use spectral::{SpectralInterrogator, centroid};
+pub use spectral::{SpectralInterrogator, centroid, line_spectrum};
 pub use thermal::ThermalLag;

@@ -58,6 +58,28 @@ impl SpectralInterrogator {
     }
 }
 
+/// The noise-free reflection spectrum of gratings at `lines_nm` \[nm\] on `cfg`'s grid: the same
+/// Gaussian lines (FWHM, peak reflectivity) [`SpectralInterrogator`] samples, summed, without its
+/// intensity noise (for the virtual interrogator's `#GetSpectrum`). Returns (grid, reflectivity).
+pub fn line_spectrum(cfg: &SpectralConfig, lines_nm: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let step = cfg.step_pm / 1000.0;
+    let n = ((cfg.end_nm - cfg.start_nm) / step).floor() as usize + 1;
+    let shape = -4.0 * std::f64::consts::LN_2 / (cfg.fwhm_nm * cfg.fwhm_nm);
+    let grid: Vec<f64> = (0..n).map(|i| cfg.start_nm + i as f64 * step).collect();
+    let reflectivity = grid
+        .iter()
+        .map(|&l| {
+            lines_nm
+                .iter()
+                .map(|&b| l - b)
+                .filter(|d| d.abs() < 3.0 * cfg.fwhm_nm)
+                .map(|d| cfg.reflectivity * (shape * d * d).exp())
+                .sum()
+        })
+        .collect();
+    (grid, reflectivity)
+}
+
 /// Centroid of the contiguous run of samples above `threshold` × maximum around the maximum;
 /// `None` for an empty channel or a flat (non-positive) maximum.
 pub fn centroid(grid_nm: &[f64], intensity: &[f64], threshold: f64) -> Option<f64> {
@@ -101,6 +123,21 @@ mod tests {
             assert!((p1 - b1).abs() < 1e-3, "{p1} vs {b1}");
             assert!((p2 - 1550.0037).abs() < 1e-3, "{p2}");
         }
+    }
+
+    #[test]
+    fn the_line_spectrum_peaks_at_the_lines_with_the_configured_reflectivity() {
+        let cfg = SpectralConfig::default();
+        let (grid, r) = line_spectrum(&cfg, &[1540.0, 1550.0]);
+        assert_eq!(grid.len(), 1801);
+        let at = |nm: f64| r[grid.iter().position(|&l| (l - nm).abs() < 1e-6).unwrap()];
+        assert!((at(1540.0) - cfg.reflectivity).abs() < 1e-12);
+        let half = cfg.reflectivity * (-4.0 * std::f64::consts::LN_2 * 0.09 / (cfg.fwhm_nm * cfg.fwhm_nm)).exp();
+        assert!((at(1540.3) - half).abs() < 1e-9, "the Gaussian line 0.3 nm off its centre");
+        assert_eq!(at(1545.0), 0.0);
+        let split = grid.partition_point(|&l| l < cfg.channel_split_nm);
+        let centre = centroid(&grid[..split], &r[..split], cfg.threshold).unwrap();
+        assert!((centre - 1540.0).abs() < 1e-3, "{centre}");
     }
 
     #[test]

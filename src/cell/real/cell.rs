@@ -24,6 +24,7 @@
 //! decorator's job.
 
 use super::config::HardwareConfig;
+use super::dashboard;
 use super::dxl::GripperBus;
 use super::dxl_link::{GripperLink, LinkStats};
 use super::interrogator::{self, PeakFeed};
@@ -53,6 +54,9 @@ pub struct RealCellConfig {
     pub rtde_port: u16,
     /// Secondary interface port for the URScript program (30002).
     pub script_port: u16,
+    /// Dashboard server port (29999): the UR5e's preconditions are checked there before the
+    /// program is uploaded ([`super::dashboard`]).
+    pub dashboard_port: u16,
     /// Dynamixel serial port (`/dev/ttyUSB0`, or the pty `tendril serve` prints).
     pub dxl_port: String,
     /// Interrogator host.
@@ -74,7 +78,8 @@ pub struct RealCellConfig {
     /// Longest wait for a motor's reply ([`super::dxl::REPLY_TIMEOUT`], 50 ms), and the watchdog
     /// on the motors' positions: older than this, the cell stops.
     pub dxl_reply_timeout: Duration,
-    /// Send the follow program to the controller at configure.
+    /// Check the UR5e's preconditions on its dashboard server, then send the follow program to
+    /// the controller, at configure.
     pub upload_program: bool,
     /// Turn Ctrl-C into a clean stop (CLI runs; not in tests).
     pub handle_ctrl_c: bool,
@@ -88,6 +93,7 @@ impl RealCellConfig {
             ur_host: ur_host.into(),
             rtde_port: 30004,
             script_port: 30002,
+            dashboard_port: 29999,
             dxl_port: dxl_port.into(),
             interrogator_host: interrogator_host.into(),
             command_port: 51971,
@@ -109,14 +115,16 @@ impl RealCellConfig {
         let host = if ip.is_unspecified() { "127.0.0.1".to_string() } else { ip.to_string() };
         let mut c = RealCellConfig::new(&host, &serve.pty_path.to_string_lossy(), &host);
         [c.rtde_port, c.script_port, c.command_port, c.stream_port] = serve.addrs.map(|a| a.port());
+        c.dashboard_port = serve.ur_addrs.dashboard.port();
         c.hardware = serve.hardware;
         c
     }
 
     /// Ports `base` (RTDE), `base+1` (URScript), `base+2` (HYPERION commands), `base+3` (peaks),
-    /// as `tendril serve --port-base` lays them out.
+    /// `base+4` (dashboard), as `tendril serve --port-base` lays them out.
     pub fn with_port_base(mut self, base: u16) -> RealCellConfig {
-        [self.rtde_port, self.script_port, self.command_port, self.stream_port] = [0, 1, 2, 3].map(|i| base + i);
+        [self.rtde_port, self.script_port, self.command_port, self.stream_port, self.dashboard_port] =
+            [0, 1, 2, 3, 4].map(|i| base + i);
         self
     }
 }
@@ -200,10 +208,14 @@ impl RealCell {
             .map_err(|e| CellError::Configure(format!("tokio runtime: {e}")))?;
         let ur_addr = format!("{}:{}", c.ur_host, c.rtde_port);
         let script_addr = format!("{}:{}", c.ur_host, c.script_port);
+        let dashboard_addr = format!("{}:{}", c.ur_host, c.dashboard_port);
         let cmd_addr = format!("{}:{}", c.interrogator_host, c.command_port);
         let stream_addr = format!("{}:{}", c.interrogator_host, c.stream_port);
         let (ur, identity, (peaks, peak_task)) = runtime
             .block_on(async {
+                if c.upload_program {
+                    dashboard::check_ready(&dashboard_addr).await.map_err(|e| e.to_string())?;
+                }
                 let ur = UrClient::connect(&ur_addr).await?;
                 if c.upload_program {
                     ur::upload_program(&script_addr, FOLLOW_SCRIPT).await?;
@@ -242,9 +254,15 @@ impl RealCell {
                 return Ok(());
             }
             if Instant::now() > deadline {
-                return Err(CellError::Configure(
-                    "within 2 s of connecting: no RTDE or peak data, or the follow program is not playing".into(),
-                ));
+                let why = match arm {
+                    None => "no RTDE data package from the UR5e".to_string(),
+                    Some(_) if !sensor => "no peak frame from the interrogator".to_string(),
+                    Some((s, _)) => format!(
+                        "the follow program is not playing (RTDE runtime_state {}, robot_mode {}, safety_mode {})",
+                        s.runtime_state, s.robot_mode, s.safety_mode
+                    ),
+                };
+                return Err(CellError::Configure(format!("within 2 s of connecting: {why}")));
             }
             std::thread::sleep(Duration::from_millis(2));
         }

@@ -2,7 +2,7 @@
 //!
 //! [`protocol`] holds the sans-IO codecs (bytes in, typed packets out, and back), for both the
 //! client side (our drivers) and the device side (the virtual devices `tendril serve` exposes).
-//! The IO layer around them: [`ur`], [`dxl`] with [`dxl_link`] (its IO thread), [`interrogator`]
+//! The IO layer around them: [`ur`] with [`dashboard`] (its preconditions), [`dxl`] with [`dxl_link`] (its IO thread), [`interrogator`]
 //! (drivers), [`cell`] ([`RealCell`]), [`config`] (the scenario's `[hardware]` section), [`tcp`]
 //! (connections), [`limits`] ([`LimitedCell`]), [`serve`] (virtual devices), [`urscript`] (the
 //! motion program), [`realtime`] (scheduling of the control thread), [`latency`] (the tick-latency
@@ -10,6 +10,7 @@
 
 pub mod cell;
 pub mod config;
+pub mod dashboard;
 pub mod dxl;
 pub mod dxl_link;
 pub mod interrogator;

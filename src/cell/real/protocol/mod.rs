@@ -5,9 +5,11 @@
 //! turn bytes into packets and packets into replies, so they are tested byte for byte.
 //!
 //! - [`rtde`]: UR Real-Time Data Exchange (TCP 30004), client and server sessions.
+//! - [`dashboard`]: the UR Dashboard Server's commands and replies (TCP 29999).
 //! - [`dynamixel`]: Dynamixel Protocol 2.0 packets and a virtual MX-106 bus.
 //! - [`hyperion`]: Luna HYPERION si255 commands, peak frames and FBG1/FBG2 mapping.
 
+pub mod dashboard;
 pub mod dynamixel;
 pub mod hyperion;
 pub mod rtde;

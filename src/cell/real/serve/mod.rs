@@ -1,23 +1,27 @@
 //! Virtual devices: the twin ([`crate::cell::sim::SimCell`] stepped in real time) behind the real protocols.
 //!
-//! - RTDE on `rtde_port` (30004) and the URScript secondary interface on `script_port` (30002): the
+//! - RTDE on `rtde_port` (30004) and URScript on `script_port` (30002) and `realtime_script_port`
+//!   (30003), a dashboard server on `dashboard_port` (29999, [`dashboard`]): the
 //!   virtual controller "runs" an uploaded program by doing what `follow.script` does (follow
 //!   `input_double_register_24..29` while `input_int_register_24` = 1, else hold); see
 //!   [`crate::cell::real::urscript`]. The program's `rtde_set_watchdog` call is honoured (the
 //!   program stops or pauses when the watched input is not written in time); targets beyond the
 //!   UR5e's joint range or speed, or non-finite, put the arm in a protective stop ([`safety`])
-//!   until a fresh program upload. `actual_TCP_pose` and `target_TCP_pose` come from [`pose`].
+//!   until unlocked on the dashboard or a fresh program upload. `actual_TCP_pose` and `target_TCP_pose` come from [`pose`].
 //! - Dynamixel: two MX-106 at the scenario's `hardware.growth_id` and `hardware.twine_id` (1, 2 by
 //!   default) on a pseudo-terminal (its path in [`ServeHandle::pty_path`]); Goal Position drives
 //!   the twin's motors, Present Position reports them; Baud Rate reads `hardware.dxl_baud`.
-//! - HYPERION: commands on `command_port` (51971), one peak frame per twin tick on `stream_port`
-//!   (51972); FBG1 and FBG2 on channel `hardware.fbg.channel`, at the wavelengths the twin's
-//!   sensor model gives.
+//! - HYPERION: commands on `command_port` (51971), one scan per twin tick (a new interrogator
+//!   sample each, the pad force held between physics steps), every scan streamed on `stream_port`
+//!   (51972) to a reader that keeps up (serial numbers consecutive; every n-th with the streaming
+//!   divider); FBG1 and FBG2 on channel `hardware.fbg.channel`, at the wavelengths the twin's
+//!   sensor model gives; `#GetSpectrum` draws them with the scenario's spectral line model.
 //!
 //! Malformed input: RTDE and HYPERION connections are closed on a framing error (after the
 //! device's error reply where the protocol has one); the bus drops corrupt packets as a device does.
 //! Nothing here panics on input.
 
+pub mod dashboard;
 mod net;
 pub mod pose;
 pub mod safety;
@@ -32,6 +36,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+pub use dashboard::{UrController, VirtualUrSetup};
 pub use twin::{DeviceState, ProgramState, TwinStatus};
 
 /// Where the virtual devices listen and how fast the twin runs.
@@ -41,8 +46,15 @@ pub struct ServeConfig {
     pub bind: IpAddr,
     /// RTDE port.
     pub rtde_port: u16,
-    /// URScript secondary interface port.
+    /// URScript secondary interface port (30002).
     pub script_port: u16,
+    /// URScript real-time interface port (30003): takes programs as the secondary one does.
+    pub realtime_script_port: u16,
+    /// UR Dashboard Server port (29999).
+    pub dashboard_port: u16,
+    /// The state the virtual UR5e starts in: remote or local control, robot mode, PolyScope
+    /// version ([`dashboard`]).
+    pub ur: VirtualUrSetup,
     /// HYPERION command port.
     pub command_port: u16,
     /// HYPERION peak stream port.
@@ -72,6 +84,9 @@ impl ServeConfig {
             bind: IpAddr::V4(Ipv4Addr::LOCALHOST),
             rtde_port: 30004,
             script_port: 30002,
+            realtime_script_port: 30003,
+            dashboard_port: 29999,
+            ur: VirtualUrSetup::default(),
             command_port: 51971,
             stream_port: 51972,
             period_s: 1e-3,
@@ -80,15 +95,27 @@ impl ServeConfig {
         }
     }
 
-    /// Ports `base`, `base+1`, `base+2`, `base+3` for RTDE, URScript, HYPERION commands and stream
+    /// Ports `base`, `base+1`, `base+2`, `base+3`, `base+4`, `base+5` for RTDE, URScript
+    /// (secondary), HYPERION commands and stream, the dashboard server and URScript (real-time)
     /// (tests and benchmarks use distinct bases so they never collide).
     pub fn with_port_base(mut self, base: u16) -> ServeConfig {
         self.rtde_port = base;
         self.script_port = base + 1;
         self.command_port = base + 2;
         self.stream_port = base + 3;
+        self.dashboard_port = base + 4;
+        self.realtime_script_port = base + 5;
         self
     }
+}
+
+/// The virtual UR5e's addresses besides RTDE and the secondary script port.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UrAddrs {
+    /// Dashboard server (29999).
+    pub dashboard: SocketAddr,
+    /// Real-time interface script port (30003).
+    pub realtime_script: SocketAddr,
 }
 
 /// The running virtual devices; dropping it stops them.
@@ -97,6 +124,8 @@ pub struct ServeHandle {
     pub pty_path: PathBuf,
     /// Addresses bound: RTDE, URScript, HYPERION commands, HYPERION stream.
     pub addrs: [SocketAddr; 4],
+    /// Addresses bound for the UR's dashboard server and real-time script port.
+    pub ur_addrs: UrAddrs,
     /// The devices' shared state (for tests comparing with the twin).
     pub state: Arc<std::sync::Mutex<DeviceState>>,
     /// The motor IDs, bus speed and FBG channel served (the scenario's `[hardware]`).
@@ -145,7 +174,7 @@ pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Resu
     anyhow::ensure!(config.period_s > 0.0 && config.period_s <= 0.01, "twin period must be in (0, 10 ms]");
     let stop = Arc::new(AtomicBool::new(false));
     let hardware = scenario.hardware;
-    let (state, ticks) = twin::shared_state(&hardware)?;
+    let (state, ticks) = twin::shared_state(&hardware, &scenario.interrogator.spectral, &config.ur)?;
     let rt = config.realtime;
     // Fail early and clearly rather than in each thread.
     let probe = std::thread::spawn(move || rt.apply_to_current_thread());
@@ -157,8 +186,18 @@ pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Resu
             let _ = rt.apply_to_current_thread();
         })
         .build()?;
-    let addrs = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe()))?;
+    let (addrs, ur_addrs) = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe()))?;
     let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone(), rt)?;
     let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone(), rt)?;
-    Ok(ServeHandle { pty_path, addrs, state, hardware, stop, twin: Some(twin), bus: Some(bus), runtime: Some(runtime) })
+    Ok(ServeHandle {
+        pty_path,
+        addrs,
+        ur_addrs,
+        state,
+        hardware,
+        stop,
+        twin: Some(twin),
+        bus: Some(bus),
+        runtime: Some(runtime),
+    })
 }

@@ -1,8 +1,10 @@
 //! The TCP side of the virtual devices: RTDE, URScript upload, HYPERION commands and stream.
 
-use super::ServeConfig;
+use super::dashboard::answer;
 use super::twin::DeviceState;
 use super::twin::ProgramState;
+use super::{ServeConfig, UrAddrs};
+use crate::cell::real::protocol::dashboard::{Command, GREETING, RobotMode};
 use crate::cell::real::protocol::rtde::{ServerConfig, ServerSession};
 use crate::cell::real::urscript::{find_watchdog, is_complete_program};
 use std::net::SocketAddr;
@@ -23,12 +25,12 @@ fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
     state.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// Binds the four listeners and spawns their accept loops; returns the bound addresses.
+/// Binds the listeners and spawns their accept loops; returns the bound addresses.
 pub async fn listen_all(
     c: &ServeConfig,
     state: Shared,
     ticks: watch::Receiver<u64>,
-) -> anyhow::Result<[SocketAddr; 4]> {
+) -> anyhow::Result<([SocketAddr; 4], UrAddrs)> {
     let bind = |port| async move {
         TcpListener::bind(SocketAddr::new(c.bind, port))
             .await
@@ -38,22 +40,29 @@ pub async fn listen_all(
     let script = bind(c.script_port).await?;
     let command = bind(c.command_port).await?;
     let stream = bind(c.stream_port).await?;
+    let dashboard = bind(c.dashboard_port).await?;
+    let realtime_script = bind(c.realtime_script_port).await?;
     let addrs = [rtde.local_addr()?, script.local_addr()?, command.local_addr()?, stream.local_addr()?];
+    let ur_addrs = UrAddrs { dashboard: dashboard.local_addr()?, realtime_script: realtime_script.local_addr()? };
     let idle = c.idle_timeout;
     {
         let (state, ticks) = (state.clone(), ticks.clone());
         tokio::spawn(accept(rtde, move |s| serve_rtde(s, state.clone(), ticks.clone(), idle)));
     }
+    for listener in [script, realtime_script] {
+        let state = state.clone();
+        tokio::spawn(accept(listener, move |s| serve_script(s, state.clone())));
+    }
     {
         let state = state.clone();
-        tokio::spawn(accept(script, move |s| serve_script(s, state.clone())));
+        tokio::spawn(accept(dashboard, move |s| serve_dashboard(s, state.clone(), idle)));
     }
     {
         let state = state.clone();
         tokio::spawn(accept(command, move |s| serve_commands(s, state.clone(), idle)));
     }
     tokio::spawn(accept(stream, move |s| serve_stream(s, state.clone(), ticks.clone())));
-    Ok(addrs)
+    Ok((addrs, ur_addrs))
 }
 
 async fn accept<F, Fut>(listener: TcpListener, handler: F)
@@ -150,10 +159,16 @@ async fn serve_script(mut socket: TcpStream, state: Shared) {
     // does not run (and the one before it has been replaced).
     let watchdog = find_watchdog(program);
     let mut s = lock(&state);
+    // In local control (PolyScope 5.6 and later) the script ports take no programs; with the
+    // robot powered off or its brakes engaged a program cannot start.
+    if !s.ur.accepts_programs() || s.ur.robot_mode != RobotMode::Running {
+        return;
+    }
     s.program_uploads += 1;
-    // A fresh upload also clears a protective stop (see `safety`): the virtual UR has no
-    // dashboard server to unlock it with.
+    // A fresh upload also clears a protective stop (see `safety`; a real controller wants
+    // `unlock protective stop` on the dashboard, which the virtual one takes as well).
     s.protective_stop = None;
+    s.ur.protective_stop_at = None;
     match watchdog {
         Ok(w) => {
             s.watchdog = w;
@@ -162,6 +177,40 @@ async fn serve_script(mut socket: TcpStream, state: Shared) {
         Err(_) => {
             s.watchdog = None;
             s.program = ProgramState::Stopped;
+        }
+    }
+}
+
+/// Longest dashboard command line accepted [bytes].
+const MAX_DASHBOARD_LINE: usize = 4096;
+
+/// The dashboard server: a greeting, then one reply line per command line; `quit`, a line longer
+/// than [`MAX_DASHBOARD_LINE`] or `idle` without a byte closes the connection.
+async fn serve_dashboard(mut socket: TcpStream, state: Shared, idle: Duration) {
+    if socket.write_all(format!("{GREETING}\n").as_bytes()).await.is_err() {
+        return;
+    }
+    let mut buf = Vec::new();
+    let mut chunk = [0u8; 1024];
+    loop {
+        match tokio::time::timeout(idle, socket.read(&mut chunk)).await {
+            Ok(Ok(n)) if n > 0 => buf.extend_from_slice(&chunk[..n]),
+            _ => return,
+        }
+        while let Some(end) = buf.iter().position(|&b| b == b'\n') {
+            let line: Vec<u8> = buf.drain(..=end).collect();
+            let command = Command::parse(&String::from_utf8_lossy(&line[..end]));
+            let (text, close) = {
+                let mut s = lock(&state);
+                let now = s.status.time_s;
+                answer(&command, &mut s, now)
+            };
+            if socket.write_all(format!("{text}\n").as_bytes()).await.is_err() || close {
+                return;
+            }
+        }
+        if buf.len() > MAX_DASHBOARD_LINE {
+            return;
         }
     }
 }
@@ -188,21 +237,19 @@ async fn serve_commands(mut socket: TcpStream, state: Shared, idle: Duration) {
     }
 }
 
-/// HYPERION peak stream: the latest frame after each twin tick (a slow reader skips frames,
-/// which its serial-number check reports).
+/// HYPERION peak stream: after each twin tick, every scan since the last one sent (a reader that
+/// keeps up gets consecutive serial numbers; one more than the backlog behind loses the oldest).
 async fn serve_stream(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>) {
+    let mut sent = None;
     while ticks.changed().await.is_ok() {
-        let frame = {
+        let bytes = {
             let s = lock(&state);
-            let (on, _) = s.interrogator.streaming();
-            if !on {
-                continue;
-            }
-            s.interrogator.stream_frame()
+            s.interrogator.stream_after(sent)
         };
-        match frame {
-            Ok(bytes) => {
-                if socket.write_all(&bytes).await.is_err() {
+        match bytes {
+            Ok((bytes, last)) => {
+                sent = last;
+                if !bytes.is_empty() && socket.write_all(&bytes).await.is_err() {
                     return;
                 }
             }

@@ -1,11 +1,16 @@
 //! The twin thread (SimCell in real time) and the Dynamixel bus on a pseudo-terminal.
 
+use super::dashboard::{UrController, VirtualUrSetup};
 use super::pose::tcp_pose;
+use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
+use crate::cell::real::protocol::dashboard::RobotMode;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
-use crate::cell::real::protocol::dynamixel::units::{baud_rate_code, rad_to_ticks, ticks_to_rad};
-use crate::cell::real::protocol::dynamixel::{StreamDecoder, VirtualBus};
+use crate::cell::real::protocol::dynamixel::units::{
+    baud_rate_code, present_current_units, present_velocity_units, rad_to_ticks, ticks_to_rad,
+};
+use crate::cell::real::protocol::dynamixel::{ControlTable, StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
 use crate::cell::real::protocol::rtde::state::{
     RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
@@ -76,9 +81,11 @@ pub struct DeviceState {
     pub watchdog: Option<RtdeWatchdog>,
     /// Programs uploaded so far (each upload restarts the program and its watchdog).
     pub program_uploads: u64,
-    /// Why the arm is in a protective stop, if it is (cleared by a fresh program upload: the
-    /// virtual UR has no dashboard server to unlock it with).
+    /// Why the arm is in a protective stop, if it is (cleared by `unlock protective stop` on the
+    /// dashboard, or by a fresh program upload).
     pub protective_stop: Option<String>,
+    /// Robot mode, remote control, PolyScope version, loaded program ([`super::dashboard`]).
+    pub ur: UrController,
     /// The MX-106 pair.
     pub bus: VirtualBus,
     /// The interrogator.
@@ -90,9 +97,12 @@ pub struct DeviceState {
 }
 
 /// The shared state and the tick channel (the twin sends its tick count after each update): the
-/// motors at `hardware`'s IDs and bus speed, an interrogator with enough channels for its FBG channel.
+/// motors at `hardware`'s IDs and bus speed, an interrogator with enough channels for its FBG
+/// channel, whose `#GetSpectrum` draws lines as `spectral` describes them.
 pub fn shared_state(
     hardware: &HardwareConfig,
+    spectral: &SpectralConfig,
+    ur: &VirtualUrSetup,
 ) -> anyhow::Result<(Arc<Mutex<DeviceState>>, tokio::sync::watch::Sender<u64>)> {
     let mut bus = VirtualBus::with_ids(&hardware.motor_ids()).map_err(|e| anyhow::anyhow!("virtual bus: {e}"))?;
     let baud = baud_rate_code(hardware.dxl_baud)
@@ -105,8 +115,12 @@ pub fn shared_state(
     // The si255 has 1, 4, 8 or 16 channels: the virtual one keeps its default 4 unless the FBG
     // channel needs more.
     let channel_count = [4, 8, 16].into_iter().find(|&n| n >= hardware.fbg.channel).unwrap_or(16) as u32;
-    let interrogator = VirtualInterrogator::new(InterrogatorConfig { channel_count, ..InterrogatorConfig::default() })
-        .map_err(|e| anyhow::anyhow!("virtual interrogator: {e}"))?;
+    let interrogator = VirtualInterrogator::new(InterrogatorConfig {
+        channel_count,
+        spectral: spectral.clone(),
+        ..InterrogatorConfig::default()
+    })
+    .map_err(|e| anyhow::anyhow!("virtual interrogator: {e}"))?;
     let state = DeviceState {
         outputs: RobotOutputs::default(),
         inputs: SharedInputs::new(),
@@ -114,6 +128,7 @@ pub fn shared_state(
         watchdog: None,
         program_uploads: 0,
         protective_stop: None,
+        ur: UrController::new(ur),
         bus,
         interrogator,
         status: TwinStatus::default(),
@@ -124,6 +139,24 @@ pub fn shared_state(
 
 fn lock(state: &Mutex<DeviceState>) -> std::sync::MutexGuard<'_, DeviceState> {
     state.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Writes what an MX-106's sensors would measure into its table: Present Position, Present
+/// Velocity and Moving from the motion, Present Current from the load on the output shaft (through
+/// the gear ratio and torque constant, [`present_current_units`]), Realtime Tick from the twin's
+/// time (milliseconds, wrapping at 32 767 as the device's does).
+fn present_motion(table: &mut ControlTable, time_s: f64, rad: f64, rad_s: f64, torque_nm: f64) {
+    let tick_ms = (time_s * 1e3).round().rem_euclid(32768.0) as u16;
+    table.put(addr::REALTIME_TICK, &tick_ms.to_le_bytes());
+    if let Ok(ticks) = rad_to_ticks(rad) {
+        table.set_present_position(ticks);
+    }
+    let velocity = present_velocity_units(rad_s);
+    table.set_present_velocity(velocity);
+    let threshold = table.u32_at(addr::MOVING_THRESHOLD);
+    table.set_moving(velocity.unsigned_abs() > threshold);
+    let limit = table.u16_at(addr::CURRENT_LIMIT);
+    table.set_present_current(present_current_units(torque_nm, limit));
 }
 
 /// Opens the pseudo-terminal pair and serves the bus on its master side until `stop`.
@@ -176,6 +209,9 @@ pub fn spawn(
         let _ = realtime.apply_to_current_thread();
         // Built here: the simulation's data stays on this thread.
         let mut cell = SimCell::for_scenario(&scenario, model);
+        // A new interrogator sample every tick (one scan period at the default 1 ms), not only when
+        // the physics steps: the peak stream then carries a new sample in each frame.
+        cell.sample_every_wait();
         let e = |e: crate::hardware::CellError| e.to_string();
         cell.configure().map_err(e)?;
         cell.activate().map_err(e)?;
@@ -188,8 +224,10 @@ pub fn spawn(
         // The physics moves the arm once per step (several twin ticks): the joint velocities are
         // the last step's displacement over its duration (the kinematic arm moves at a constant
         // rate within a step), held until the next step changes them.
-        let mut last_step = (first.time_s, first.arm_q);
+        let mut last_step = (first.time_s, first.arm_q, [first.growth_motor_rad, first.twine_motor_rad]);
         let mut actual_qd = [0.0; ARM_JOINTS];
+        // The motors' speeds, the same way (Present Velocity).
+        let mut motor_rad_s = [0.0; 2];
         let mut measured_q = first.arm_q;
         // The program's RTDE watchdog once armed: the watched input's write count and when it last
         // changed (twin time, so a twin held up by a lock never counts as a silent client).
@@ -254,6 +292,11 @@ pub fn spawn(
                         Some(_) => {}
                     }
                 }
+                // Powered off or brakes engaged (dashboard): no program runs, the arm holds.
+                if s.ur.robot_mode != RobotMode::Running && s.program != ProgramState::Stopped {
+                    s.program = ProgramState::Stopped;
+                    hold = true;
+                }
                 let mut new = false;
                 if s.program == ProgramState::Playing && enabled && arrived {
                     match super::safety::violation(&targets, &measured_q) {
@@ -264,6 +307,7 @@ pub fn spawn(
                         Some(why) => {
                             // Protective stop: the arm stops where it is, the program stops.
                             s.protective_stop = Some(why);
+                            s.ur.protective_stop_at = Some(now_s);
                             s.program = ProgramState::Stopped;
                             hold = true;
                         }
@@ -291,11 +335,16 @@ pub fn spawn(
             cell.wait_until(k as f64 * period_s).map_err(e)?;
             let r = cell.read().map_err(e)?;
             let truth = cell.ground_truth().unwrap_or_default();
+            let motors_rad = [r.growth_motor_rad, r.twine_motor_rad];
             if r.time_s > last_step.0 + 1e-12 {
                 let dt = r.time_s - last_step.0;
                 actual_qd = std::array::from_fn(|j| (r.arm_q[j] - last_step.1[j]) / dt);
-                last_step = (r.time_s, r.arm_q);
+                motor_rad_s = std::array::from_fn(|m| (motors_rad[m] - last_step.2[m]) / dt);
+                last_step = (r.time_s, r.arm_q, motors_rad);
             }
+            // The load on each motor's output shaft: the tendon's tension on the twine spool; the
+            // growth motor's load is not modelled (0).
+            let motor_torque_nm = [0.0, cell.tendon_tension_n() * cell.twine_spool_radius_m()];
             measured_q = r.arm_q;
             {
                 let mut s = lock(&state);
@@ -306,10 +355,12 @@ pub fn spawn(
                     ProgramState::Playing => RUNTIME_STATE_PLAYING,
                     ProgramState::Paused => RUNTIME_STATE_PAUSED,
                 };
+                let robot_mode = s.ur.robot_mode.rtde();
                 let safety_mode =
                     if s.protective_stop.is_some() { SAFETY_MODE_PROTECTIVE_STOP } else { SAFETY_MODE_NORMAL };
                 let o = &mut s.outputs;
                 o.runtime_state = runtime_state;
+                o.robot_mode = robot_mode;
                 o.safety_mode = safety_mode;
                 o.timestamp_s = r.time_s;
                 o.actual_qd = actual_qd;
@@ -318,17 +369,18 @@ pub fn spawn(
                 o.actual_tcp_pose = tcp_pose(&r.arm_q, &o.tcp_offset);
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
                 o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
-                for (id, rad) in motors.into_iter().zip([r.growth_motor_rad, r.twine_motor_rad]) {
-                    if let (Some(t), Ok(ticks)) = (s.bus.table_mut(id), rad_to_ticks(rad)) {
-                        t.set_present_position(ticks);
+                for (m, id) in motors.into_iter().enumerate() {
+                    if let Some(t) = s.bus.table_mut(id) {
+                        present_motion(t, r.time_s, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
                     }
                 }
-                let nanos = (r.time_s.fract() * 1e9) as u32;
+                // Scan k, stamped with its twin time (the physics may lag it by part of a step).
+                let scan_s = k as f64 * period_s;
                 let frame = PeakFrame {
                     header: PeakHeader {
                         serial_number: k,
-                        timestamp_s: r.time_s as u32,
-                        timestamp_ns: nanos,
+                        timestamp_s: scan_s as u32,
+                        timestamp_ns: (scan_s.fract() * 1e9) as u32,
                         ..PeakHeader::default()
                     },
                     channels: (1..=channel)
@@ -350,6 +402,11 @@ pub fn spawn(
             let now = Instant::now();
             if deadline > now {
                 std::thread::sleep(deadline - now);
+            } else {
+                // Behind real time, the twin runs tick after tick; the devices' mutex is not fair,
+                // so without a pause here the bus and network threads waiting for it could be
+                // passed over tick after tick (the virtual MX-106 then missed replies for 200 ms).
+                std::thread::yield_now();
             }
         }
         Ok(())

@@ -1,11 +1,16 @@
 //! The MX-106 (Protocol 2.0, model number 321) control table.
 //!
-//! Source: ROBOTIS e-manual "MX-106T/R(2.0)" control table, as listed in
-//! `shared/reference/hardware.md` for the fields our drivers use (Operating Mode, Torque Enable,
-//! Goal/Present Current, Velocity, Position, Profile, Temperature) and Model Number 321.
-//! The remaining addresses, sizes and defaults are the e-manual's as we recall them and are
-//! **unverified against the manual**; the initial values marked `guess` are ours.
-//! Indirect addresses (168 and up) are not modelled: reads or writes there get an Access error.
+//! Source: ROBOTIS e-manual "MX-106(2.0)" (emanual.robotis.com/docs/en/dxl/mx/mx-106-2/): the
+//! addresses, sizes, access and initial values of both tables (EEPROM and RAM) are the manual's;
+//! where the manual gives "-" (measured or set by the device) the initial values marked `guess`
+//! are ours. Indirect addresses (168 and up) are not modelled: reads or writes there get an Access
+//! error.
+//!
+//! Writes are checked as the device checks them (e-manual, Protocol 2.0 "Status Packet"): a byte
+//! of a read-only or undefined address, or of EEPROM while torque is on, is an Access error
+//! (0x07); a write that covers only part of a field is a Data Length error (0x05); a value outside
+//! the field's range is a Data Range error (0x04). The ranges checked are [`ControlTable::range`]'s,
+//! from the field descriptions of the same manual; fields it does not list accept any value.
 
 use super::DxlError;
 
@@ -58,6 +63,18 @@ pub mod addr {
     pub const BAUD_RATE: u16 = 8;
     /// Operating Mode (1): 0 current, 1 velocity, 3 position, 4 extended position, 5 current-based position, 16 PWM.
     pub const OPERATING_MODE: u16 = 11;
+    /// Moving Threshold (4, 0.229 rpm units): above it, Moving reads 1.
+    pub const MOVING_THRESHOLD: u16 = 24;
+    /// PWM Limit (2).
+    pub const PWM_LIMIT: u16 = 36;
+    /// Current Limit (2, 3.36 mA units).
+    pub const CURRENT_LIMIT: u16 = 38;
+    /// Velocity Limit (4, 0.229 rpm units).
+    pub const VELOCITY_LIMIT: u16 = 44;
+    /// Max Position Limit (4, ticks; position mode only).
+    pub const MAX_POSITION_LIMIT: u16 = 48;
+    /// Min Position Limit (4, ticks; position mode only).
+    pub const MIN_POSITION_LIMIT: u16 = 52;
     /// Torque Enable (1).
     pub const TORQUE_ENABLE: u16 = 64;
     /// Status Return Level (1): 0 ping only, 1 ping and read, 2 all.
@@ -66,6 +83,8 @@ pub mod addr {
     pub const REGISTERED_INSTRUCTION: u16 = 69;
     /// Hardware Error Status (1).
     pub const HARDWARE_ERROR_STATUS: u16 = 70;
+    /// Goal PWM (2, signed).
+    pub const GOAL_PWM: u16 = 100;
     /// Goal Current (2, 3.36 mA units).
     pub const GOAL_CURRENT: u16 = 102;
     /// Goal Velocity (4, 0.229 rpm units).
@@ -76,6 +95,8 @@ pub mod addr {
     pub const PROFILE_VELOCITY: u16 = 112;
     /// Goal Position (4, 4096 ticks/rev).
     pub const GOAL_POSITION: u16 = 116;
+    /// Realtime Tick (2, ms, wraps at 32 767).
+    pub const REALTIME_TICK: u16 = 120;
     /// Moving (1).
     pub const MOVING: u16 = 122;
     /// Present Current (2, signed).
@@ -94,7 +115,9 @@ pub mod addr {
 pub const FIELDS: &[Field] = &[
     f("Model Number", 0, 2, R, MX106_MODEL_NUMBER as u32),
     f("Model Information", 2, 4, R, 0),
-    f("Firmware Version", 6, 1, R, 45), // guess: a recent MX(2.0) firmware number
+    // guess: a recent MX(2.0) firmware (42 and later have the Clear instruction, the lower
+    // Velocity Limit and ignore a broadcast Factory Reset 0xFF; the virtual bus follows those).
+    f("Firmware Version", 6, 1, R, 45),
     f("ID", 7, 1, RW, 1),
     f("Baud Rate", 8, 1, RW, 1), // 1 = 57600 bps
     f("Return Delay Time", 9, 1, RW, 250),
@@ -110,7 +133,7 @@ pub const FIELDS: &[Field] = &[
     f("PWM Limit", 36, 2, RW, 885),
     f("Current Limit", 38, 2, RW, 2047),
     f("Acceleration Limit", 40, 4, RW, 32767),
-    f("Velocity Limit", 44, 4, RW, 210),
+    f("Velocity Limit", 44, 4, RW, 360), // the manual's table (0.229 rpm units: 82.4 rpm)
     f("Max Position Limit", 48, 4, RW, 4095),
     f("Min Position Limit", 52, 4, RW, 0),
     f("Shutdown", 63, 1, RW, 52),
@@ -145,6 +168,12 @@ pub const FIELDS: &[Field] = &[
     f("Present Input Voltage", 144, 2, R, 120), // guess: 12.0 V supply
     f("Present Temperature", 146, 1, R, 30),    // guess: 30 °C
 ];
+
+/// Operating Mode values the MX-106(2.0) has: current, velocity, position, extended position,
+/// current-based position, PWM.
+pub const OPERATING_MODES: [u8; 6] = [0, 1, 3, 4, 5, 16];
+/// Operating Mode 3, position control within one turn.
+pub const POSITION_MODE: u8 = 3;
 
 /// The field that contains `address`, if any.
 pub fn field_at(address: u16) -> Option<&'static Field> {
@@ -247,11 +276,12 @@ impl ControlTable {
         Ok(&self.bytes[start..end])
     }
 
-    /// Writes `data` at `address` as the host would: every byte must belong to a writable field,
-    /// and EEPROM only while torque is off.
+    /// Writes `data` at `address` as the host would: every byte must belong to a writable field
+    /// (EEPROM only while torque is off), every field touched must be written whole, and every
+    /// value must be in its [`ControlTable::range`]. Nothing is written unless all of it is valid.
     pub fn write(&mut self, address: u16, data: &[u8]) -> Result<(), DxlError> {
         let length = u16::try_from(data.len()).map_err(|_| DxlError::OutOfTable { address, length: u16::MAX })?;
-        let (start, _) = self.span(address, length)?;
+        let (start, end) = self.span(address, length)?;
         for offset in 0..length {
             let at = address + offset;
             match field_at(at) {
@@ -263,7 +293,88 @@ impl ControlTable {
                 _ => return Err(DxlError::NotWritable { address: at }),
             }
         }
-        self.bytes[start..start + data.len()].copy_from_slice(data);
+        let touched: Vec<&'static Field> =
+            FIELDS.iter().filter(|f| usize::from(f.address) < end && usize::from(f.address + f.size) > start).collect();
+        if let Some(f) =
+            touched.iter().find(|f| usize::from(f.address) < start || usize::from(f.address + f.size) > end)
+        {
+            return Err(DxlError::DataLength { address: f.address, size: f.size });
+        }
+        // Ranges may depend on other fields written in the same packet (a limit and its goal).
+        let mut candidate = self.clone();
+        candidate.bytes[start..end].copy_from_slice(data);
+        for field in touched {
+            candidate.check_range(field)?;
+        }
+        *self = candidate;
+        Ok(())
+    }
+
+    /// The values `field` accepts in this table's state (its operating mode and limits), as the
+    /// e-manual's field descriptions give them; `None` when any value is accepted.
+    ///
+    /// Operating Mode accepts only 0, 1, 3, 4, 5 and 16 within this range ([`OPERATING_MODES`]).
+    pub fn range(&self, field: &Field) -> Option<(i64, i64)> {
+        let limit = |address| i64::from(self.u32_at(address));
+        let limit16 = |address| i64::from(self.u16_at(address));
+        Some(match field.address {
+            addr::ID => (0, 252),
+            addr::BAUD_RATE => (0, 7),
+            addr::OPERATING_MODE => (0, 16),
+            13 => (1, 2),                        // Protocol Type
+            20 => (-1_044_479, 1_044_479),       // Homing Offset
+            addr::MOVING_THRESHOLD => (0, 1023), // Moving Threshold
+            31 => (0, 100),                      // Temperature Limit
+            32 | 34 => (95, 160),                // Max/Min Voltage Limit
+            addr::PWM_LIMIT => (0, 885),
+            addr::CURRENT_LIMIT => (0, 2047),
+            40 => (0, 32767), // Acceleration Limit
+            addr::VELOCITY_LIMIT => (0, 1023),
+            addr::MAX_POSITION_LIMIT | addr::MIN_POSITION_LIMIT => (0, 4095),
+            addr::TORQUE_ENABLE | 65 => (0, 1), // Torque Enable, LED
+            addr::STATUS_RETURN_LEVEL => (0, 2),
+            76..=90 => (0, 16383), // the PID and feedforward gains
+            98 => (0, 127),        // Bus Watchdog (1..127 × 20 ms; 0 off)
+            addr::GOAL_PWM => (-limit16(addr::PWM_LIMIT), limit16(addr::PWM_LIMIT)),
+            addr::GOAL_CURRENT => (-limit16(addr::CURRENT_LIMIT), limit16(addr::CURRENT_LIMIT)),
+            addr::GOAL_VELOCITY => (-limit(addr::VELOCITY_LIMIT), limit(addr::VELOCITY_LIMIT)),
+            addr::PROFILE_ACCELERATION | addr::PROFILE_VELOCITY => (0, 32767),
+            addr::GOAL_POSITION => match self.operating_mode() {
+                // Position mode: one turn, within the position limits.
+                POSITION_MODE => (limit(addr::MIN_POSITION_LIMIT), limit(addr::MAX_POSITION_LIMIT)),
+                // Extended and current-based position: ±256 turns.
+                _ => (-1_048_575, 1_048_575),
+            },
+            _ => return None,
+        })
+    }
+
+    /// The value of `field` (sign-extended where the field is signed).
+    pub fn value(&self, field: &Field) -> i64 {
+        let signed = matches!(
+            field.address,
+            20 | addr::GOAL_PWM | addr::GOAL_CURRENT | addr::GOAL_VELOCITY | addr::GOAL_POSITION | 124..=143
+        );
+        match (field.size, signed) {
+            (1, _) => i64::from(self.bytes[usize::from(field.address)]),
+            (2, false) => i64::from(self.u16_at(field.address)),
+            (2, true) => i64::from(self.u16_at(field.address) as i16),
+            (_, false) => i64::from(self.u32_at(field.address)),
+            (_, true) => i64::from(self.u32_at(field.address) as i32),
+        }
+    }
+
+    fn check_range(&self, field: &'static Field) -> Result<(), DxlError> {
+        let value = self.value(field);
+        let out = |(min, max)| DxlError::OutOfRange { name: field.name, value, min, max };
+        if let Some((min, max)) = self.range(field)
+            && !(min..=max).contains(&value)
+        {
+            return Err(out((min, max)));
+        }
+        if field.address == addr::OPERATING_MODE && !OPERATING_MODES.contains(&(value as u8)) {
+            return Err(out((0, 16)));
+        }
         Ok(())
     }
 

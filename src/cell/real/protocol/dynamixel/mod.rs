@@ -42,12 +42,18 @@ pub enum DxlError {
         len: usize,
     },
     /// The CRC does not match.
-    #[error("CRC mismatch: computed {expected:#06x}, received {received:#06x}")]
+    #[error(
+        "CRC mismatch in a packet to ID {id} (instruction {instruction:#04x}): computed {expected:#06x}, received {received:#06x}"
+    )]
     BadCrc {
         /// CRC of the received bytes.
         expected: u16,
         /// CRC field of the packet.
         received: u16,
+        /// The packet's ID field (a device with this ID answers with a CRC error status).
+        id: u8,
+        /// The packet's instruction field (0x55 for a status packet).
+        instruction: u8,
     },
     /// A packet to encode is too long.
     #[error("packet of {len} bytes exceeds the {max}-byte limit")]
@@ -96,6 +102,27 @@ pub enum DxlError {
     EepromLocked {
         /// First offending address.
         address: u16,
+    },
+    /// A write covers only part of a field (the e-manual's example: 2 bytes to the 4-byte Goal
+    /// Position); status error 0x05.
+    #[error("the write covers only part of the {size}-byte field at address {address}")]
+    DataLength {
+        /// Start address of the field.
+        address: u16,
+        /// Size of the field.
+        size: u16,
+    },
+    /// A value outside the field's range (status error 0x04).
+    #[error("{name} {value} is outside its range {min}..={max}")]
+    OutOfRange {
+        /// The field's name (e-manual).
+        name: &'static str,
+        /// The value written.
+        value: i64,
+        /// Lowest value allowed.
+        min: i64,
+        /// Highest value allowed.
+        max: i64,
     },
     /// Invalid or duplicate device ID.
     #[error("device ID {0} is invalid or already on the bus")]

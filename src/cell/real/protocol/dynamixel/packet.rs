@@ -78,7 +78,8 @@ impl RawPacket {
         let expected = crc16(&buf[..total - 2]);
         let received = u16::from_le_bytes([buf[total - 2], buf[total - 1]]);
         if expected != received {
-            return Decoded::Invalid { error: DxlError::BadCrc { expected, received }, consumed: 1 };
+            let error = DxlError::BadCrc { expected, received, id: buf[4], instruction: buf[7] };
+            return Decoded::Invalid { error, consumed: 1 };
         }
         let packet = RawPacket { id: buf[4], instruction: buf[7], body: unstuff(&buf[8..total - 2]) };
         Decoded::Frame { packet, consumed: total }

@@ -4,11 +4,15 @@
 //! - [`peaks`]: the peak data frame, and serial-number continuity of the stream.
 //! - [`device`]: [`VirtualInterrogator`], the device side `tendril serve` runs.
 //! - [`fbg_map`]: peaks to FBG1/FBG2 by wavelength window.
+//! - [`stream`]: the peak stream's backlog and divider.
+//! - [`spectrum`]: `#GetSpectrum`, power calibration and detection setting contents.
 
 pub mod device;
 pub mod fbg_map;
 pub mod message;
 pub mod peaks;
+pub mod spectrum;
+pub mod stream;
 
 pub use device::{InterrogatorConfig, VirtualInterrogator};
 pub use fbg_map::{FbgMapError, FbgWindows};

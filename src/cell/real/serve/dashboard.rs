@@ -1,0 +1,171 @@
+//! The virtual UR5e's dashboard server: what each command does to the controller's state.
+//!
+//! The controller's state besides the program (which lives in [`DeviceState::program`]): robot
+//! mode, local or remote control, PolyScope version, the loaded program. [`VirtualUrSetup`] puts
+//! it in a given state at start (tests use it to make each precondition of the real path fail);
+//! the dashboard commands change it as PolyScope would:
+//!
+//! - `power on` → IDLE, `brake release` → RUNNING, `power off` → POWER_OFF (the program stops);
+//! - `play` starts the loaded or uploaded program if the robot is RUNNING, not protective-stopped
+//!   and in remote control; `stop`, `pause` as on the pendant;
+//! - `load NAME.urp` loads the one program the virtual controller has (it follows the RTDE
+//!   registers, as `follow.script` does) under that name; any other name is not found;
+//! - in local control (PolyScope 5.6 and later) `power on`, `power off`, `brake release`, `play`
+//!   and `load` are refused, and programs sent to the script ports are ignored;
+//! - `unlock protective stop` clears a protective stop from 5 s after it on;
+//! - `is in remote control` is not understood before PolyScope 5.6, as there.
+
+use super::twin::{DeviceState, ProgramState};
+use crate::cell::real::protocol::dashboard::{
+    Command, PolyscopeVersion, RobotMode, SafetyStatus, file_not_found, loading, not_understood, reply,
+};
+
+/// How long after a protective stop it may be unlocked \[s\] (the controller's rule).
+pub const UNLOCK_DELAY_S: f64 = 5.0;
+
+/// The state the virtual UR starts in (`ServeConfig::ur`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct VirtualUrSetup {
+    /// Remote control (true) or local control (false; PolyScope 5.6 and later).
+    pub remote_control: bool,
+    /// Robot mode at start (RUNNING: powered, brakes released).
+    pub robot_mode: RobotMode,
+    /// The `PolyscopeVersion` reply.
+    pub polyscope_version: String,
+}
+
+impl Default for VirtualUrSetup {
+    fn default() -> Self {
+        VirtualUrSetup {
+            remote_control: true,
+            robot_mode: RobotMode::Running,
+            polyscope_version: "URSoftware 5.11.1.108318 (Mar 23 2021)".into(),
+        }
+    }
+}
+
+/// The controller's state the dashboard server shows and changes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UrController {
+    /// Robot mode.
+    pub robot_mode: RobotMode,
+    /// Remote control.
+    pub remote_control: bool,
+    /// The `PolyscopeVersion` reply.
+    pub polyscope_version: String,
+    /// The program loaded with `load`, if any.
+    pub loaded_program: Option<String>,
+    /// Twin time of the current protective stop \[s\].
+    pub protective_stop_at: Option<f64>,
+}
+
+impl UrController {
+    /// The controller in `setup`'s state.
+    pub fn new(setup: &VirtualUrSetup) -> UrController {
+        UrController {
+            robot_mode: setup.robot_mode,
+            remote_control: setup.remote_control,
+            polyscope_version: setup.polyscope_version.clone(),
+            loaded_program: None,
+            protective_stop_at: None,
+        }
+    }
+
+    /// Whether this PolyScope has remote control (5.6 and later).
+    pub fn has_remote_control(&self) -> bool {
+        PolyscopeVersion::parse_reply(&self.polyscope_version).is_some_and(|v| v >= PolyscopeVersion::REMOTE_CONTROL)
+    }
+
+    /// Whether programs may be started from outside (remote control, or a PolyScope before 5.6).
+    pub fn accepts_programs(&self) -> bool {
+        self.remote_control || !self.has_remote_control()
+    }
+}
+
+/// The reply to `command` at twin time `now_s`, and whether the connection closes after it.
+pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bool) {
+    let remote_only = matches!(
+        command,
+        Command::PowerOn | Command::PowerOff | Command::BrakeRelease | Command::Play | Command::Load(_)
+    );
+    if remote_only && !s.ur.accepts_programs() {
+        return (reply::LOCAL_CONTROL.into(), false);
+    }
+    let text = match command {
+        Command::RobotMode => s.ur.robot_mode.reply(),
+        Command::ProgramState => {
+            let state = match s.program {
+                ProgramState::Stopped => "STOPPED",
+                ProgramState::Playing => "PLAYING",
+                ProgramState::Paused => "PAUSED",
+            };
+            format!("{state} {}", s.ur.loaded_program.as_deref().unwrap_or("<unnamed>"))
+        }
+        Command::Running => format!("Program running: {}", s.program == ProgramState::Playing),
+        Command::IsInRemoteControl if s.ur.has_remote_control() => s.ur.remote_control.to_string(),
+        Command::IsInRemoteControl => not_understood("is in remote control"),
+        Command::PowerOn => {
+            if s.ur.robot_mode == RobotMode::PowerOff {
+                s.ur.robot_mode = RobotMode::Idle;
+            }
+            reply::POWERING_ON.into()
+        }
+        Command::PowerOff => {
+            s.ur.robot_mode = RobotMode::PowerOff;
+            s.program = ProgramState::Stopped;
+            reply::POWERING_OFF.into()
+        }
+        Command::BrakeRelease => {
+            if s.ur.robot_mode != RobotMode::PowerOff {
+                s.ur.robot_mode = RobotMode::Running;
+            }
+            reply::BRAKE_RELEASING.into()
+        }
+        Command::Play => {
+            let ready = s.ur.robot_mode == RobotMode::Running && s.protective_stop.is_none();
+            if ready && (s.ur.loaded_program.is_some() || s.program_uploads > 0) {
+                s.program = ProgramState::Playing;
+                reply::STARTING_PROGRAM.into()
+            } else {
+                reply::PLAY_FAILED.into()
+            }
+        }
+        Command::Stop if s.program != ProgramState::Stopped => {
+            s.program = ProgramState::Stopped;
+            reply::STOPPED.into()
+        }
+        Command::Stop => reply::STOP_FAILED.into(),
+        Command::Pause if s.program == ProgramState::Playing => {
+            s.program = ProgramState::Paused;
+            reply::PAUSING.into()
+        }
+        Command::Pause => reply::PAUSE_FAILED.into(),
+        Command::Load(file) if file.ends_with(".urp") => {
+            s.ur.loaded_program = Some(file.clone());
+            s.program = ProgramState::Stopped;
+            loading(file)
+        }
+        Command::Load(file) => file_not_found(file),
+        Command::SafetyStatus => safety(s).reply(),
+        Command::SafetyMode => format!("Safetymode: {}", safety(s).name()),
+        Command::PolyscopeVersion => s.ur.polyscope_version.clone(),
+        Command::CloseSafetyPopup => reply::CLOSING_SAFETY_POPUP.into(),
+        Command::UnlockProtectiveStop => match s.ur.protective_stop_at {
+            Some(at) if s.protective_stop.is_some() && now_s - at < UNLOCK_DELAY_S => {
+                reply::PROTECTIVE_STOP_TOO_SOON.into()
+            }
+            _ => {
+                s.protective_stop = None;
+                s.ur.protective_stop_at = None;
+                reply::PROTECTIVE_STOP_RELEASING.into()
+            }
+        },
+        Command::Quit => return (reply::DISCONNECTED.into(), true),
+        Command::Unknown(text) => not_understood(text),
+    };
+    (text, false)
+}
+
+fn safety(s: &DeviceState) -> SafetyStatus {
+    if s.protective_stop.is_some() { SafetyStatus::ProtectiveStop } else { SafetyStatus::Normal }
+}
