@@ -229,11 +229,17 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
                 a.0,
                 b.0
             );
-            assert!((derivative - speed[j]).abs() < 0.25 * speed[j].abs(), "joint {j}: {derivative} vs {}", speed[j]);
         }
         windows += 1;
     }
     assert!(windows > 20);
+    // The speed is the commanded one over the whole span (over one 50 ms window a target the
+    // client sent a tick late on a loaded machine moves it by a quarter).
+    let (a, b) = (inside[0], inside[inside.len() - 1]);
+    for j in [0, 4] {
+        let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
+        assert!((derivative - speed[j]).abs() < 0.1 * speed[j].abs(), "joint {j}: {derivative} vs {}", speed[j]);
+    }
 }
 
 /// Issue: a program plus 100 rad (or 1e308, or NaN) targets with enable = 1 made the twin
