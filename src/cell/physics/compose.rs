@@ -48,7 +48,6 @@ pub const MIN_CURL_RADIUS_M: f64 = 0.00875;
 /// curled by a tendon on one side and never bends far the other way.
 pub const MIN_BACK_RADIUS_M: f64 = 0.0175 / 0.3;
 
-
 /// The segment template without its `<joint .../>` element: a segment welded to its parent.
 fn without_joint(segment: &str) -> String {
     match segment.find("<joint").and_then(|start| segment[start..].find("/>").map(|end| (start, start + end + 2))) {
