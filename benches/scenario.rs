@@ -21,24 +21,35 @@ fn full_scenario(c: &mut Criterion) {
     let mut group = c.benchmark_group("scenario");
     group.sample_size(10).measurement_time(Duration::from_secs(20));
     let runs = ["crimper", "shampoo", "hammer"].into_iter().flat_map(|n| [(n, Backend::Mujoco), (n, Backend::Rapier)]);
+    // `cargo test --all-targets` runs each bench once to check it works; the timed runs below are
+    // for `cargo bench` (which passes `--bench`) only.
+    let timed = std::env::args().any(|a| a == "--bench");
     for (name, backend) in runs {
         let s = scenario(name, backend);
         let name = format!("{name}_{}", backend.name());
         let models = ModelCache::default();
-        let (summary, _) = run_on_twin(&s, &models, None).expect("runs");
-        let started = Instant::now();
-        let (again, _) = run_on_twin(&s, &models, None).expect("runs");
-        let wall = started.elapsed().as_secs_f64();
-        assert_eq!(summary.outcome, again.outcome, "deterministic");
-        println!(
-            "{name}: {:.1} simulated s in {:.3} s wall = {:.0}x real time (one core, model compiled once)",
-            again.sim_time_s,
-            wall,
-            again.sim_time_s / wall
-        );
+        if timed {
+            print_real_time_factor(&name, &s, &models);
+        }
         group.bench_function(&name, |b| b.iter(|| run_on_twin(&s, &models, None).expect("runs")));
     }
     group.finish();
+}
+
+/// Runs `s` twice (the second with the model already compiled), checks both agree and prints the
+/// simulated seconds per wall second.
+fn print_real_time_factor(name: &str, s: &PickPlaceScenario, models: &ModelCache) {
+    let (summary, _) = run_on_twin(s, models, None).expect("runs");
+    let started = Instant::now();
+    let (again, _) = run_on_twin(s, models, None).expect("runs");
+    let wall = started.elapsed().as_secs_f64();
+    assert_eq!(summary.outcome, again.outcome, "deterministic");
+    println!(
+        "{name}: {:.1} simulated s in {:.3} s wall = {:.0}x real time (one core, model compiled once)",
+        again.sim_time_s,
+        wall,
+        again.sim_time_s / wall
+    );
 }
 
 criterion_group!(benches, full_scenario);
