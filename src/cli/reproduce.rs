@@ -20,14 +20,20 @@ pub struct ReproduceArgs {
     /// The twin's physics engine for Sec. V, `mujoco` or `rapier` (default: the scenarios' own).
     #[arg(long)]
     backend: Option<crate::cell::physics::Backend>,
+    /// Scenario keys from a file (what `tendril fit` and `tendril tune` write), applied to the Sec. V
+    /// scenarios after each file and before `--set`.
+    #[arg(long)]
+    overlay: Option<PathBuf>,
     /// Override a value of the Sec. V scenarios: `--set key.path=value` (repeatable).
     #[arg(long = "set")]
     set: Vec<Override>,
 }
 
 pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
-    let mut overrides = a.set.clone();
-    overrides.extend(a.backend.map(Override::backend));
+    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let mut set = a.set.clone();
+    set.extend(a.backend.map(Override::backend));
+    let overrides = overlay.then(&set);
     let rows = reproduce_rows(&a.what, &a.scenarios, &overrides)?;
     emit(&render_table(&rows));
     if let Some(path) = a.json {
