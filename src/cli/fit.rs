@@ -17,6 +17,11 @@ pub struct FitArgs {
     /// Worker threads [default: all cores], 1 to 1024.
     #[arg(long, value_parser = super::sweep::threads_or_all)]
     threads: Option<usize>,
+    /// Start from the values this overlay gives (a previous fit's overlay.toml) instead of the
+    /// fit file's `start`; with `evaluations = 1`, scores those values on the recordings (held-out
+    /// predictions).
+    #[arg(long)]
+    start: Option<PathBuf>,
     /// Continue the search logged in the output folder (evaluations already logged are not run
     /// again).
     #[arg(long)]
@@ -24,7 +29,8 @@ pub struct FitArgs {
 }
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
-    let fit = crate::fit::load_fit(&a.fit)?;
+    let mut fit = crate::fit::load_fit(&a.fit)?;
+    fit.start_from(&crate::scenario::Overlay::load(a.start.as_deref())?)?;
     let stem = a.fit.file_stem().map_or("fit".into(), |s| s.to_string_lossy().to_string());
     let out_dir = a.out.unwrap_or_else(|| PathBuf::from("out").join(format!("fit-{stem}")));
     crate::interrupt::install()?;

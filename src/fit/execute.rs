@@ -42,6 +42,8 @@ pub fn replay(fit: &Fit, r: &Recording, values: &[f64]) -> (Residual, Option<Run
             Residual {
                 recording: r.name.clone(),
                 force_rmse_n: None,
+                smoothed_rmse_n: None,
+                twine_motor_rmse_rad: None,
                 drop_time_error_s: None,
                 same_outcome: false,
                 outcome: format!("error: {e:#}"),
@@ -160,8 +162,17 @@ fn write_results(
     threads: Option<usize>,
 ) -> anyhow::Result<(FitReport, Vec<PathBuf>)> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
-    let replays: Vec<(Residual, Option<RunReport>)> =
-        pool.install(|| fit.recordings.par_iter().map(|r| replay(fit, r, &result.best)).collect());
+    // Stopped by a signal: the best candidate's residuals as logged (a replay would be cut short).
+    let replays: Vec<(Residual, Option<RunReport>)> = if crate::interrupt::requested().is_some() {
+        let logged: Vec<Residual> = result
+            .best_record
+            .as_ref()
+            .and_then(|r| serde_json::from_value(r.detail["residuals"].clone()).ok())
+            .unwrap_or_default();
+        logged.into_iter().map(|r| (r, None)).collect()
+    } else {
+        pool.install(|| fit.recordings.par_iter().map(|r| replay(fit, r, &result.best)).collect())
+    };
     let objective = result.best_record.as_ref().and_then(|r| r.exact_objective()).unwrap_or(FAILED);
     let start: Vec<f64> = fit.params.iter().map(|p| p.start).collect();
     let start_objective = result
@@ -201,12 +212,13 @@ fn write_results(
     let json = out_dir.join("fit.json");
     super::write_text(&json, &(serde_json::to_string_pretty(&report)? + "\n"))?;
     written.push(json);
+    let empty = (Residual::default(), None);
     let chart = crate::plot::fit::FitChart {
         title: format!("tendril fit {}", fit.file.display()),
         traces: fit
             .recordings
             .iter()
-            .zip(&replays)
+            .zip(replays.iter().chain(std::iter::repeat(&empty)))
             .map(|(r, (res, rep))| crate::plot::fit::TracePair {
                 name: format!("{} (RMSE {})", r.name, res.force_rmse_n.map_or("-".into(), |v| format!("{v:.3} N"))),
                 recorded: r.ticks.iter().map(|t| (t.time_s, t.force_n)).collect(),

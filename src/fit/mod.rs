@@ -6,7 +6,7 @@
 //! - [`objective`]: the distance between a simulated run and a recording.
 //! - [`optimizer`]: the CMA-ES search, parallel, over the unit cube of the parameters.
 //! - [`log`]: the durable log of every evaluation, for `--resume`.
-//! - [`spec`]: FIT.toml.
+//! - [`spec`]: the fit file (FIT.toml).
 //! - [`execute`]: running a fit and writing its results.
 //! - [`tune`]: TUNE.toml and running a tune.
 

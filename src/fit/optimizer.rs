@@ -111,10 +111,12 @@ where
             .filter_map(|r| Some((r.exact_values()?.iter().map(|v| v.to_bits()).collect(), r.clone())))
             .collect(),
     );
+    // The budget counts the earlier sessions' evaluations too: a resumed search ends where the
+    // uninterrupted one would have.
+    let reused = previous.len();
+    let used = std::sync::atomic::AtomicUsize::new(reused);
     let history = Mutex::new(previous);
     let log = Mutex::new(log);
-    let used = std::sync::atomic::AtomicUsize::new(0);
-    let reused = std::sync::atomic::AtomicUsize::new(0);
     let write_error: Mutex<Option<LogError>> = Mutex::new(None);
     let progress = indicatif::ProgressBar::new(budget.evaluations as u64);
     progress.set_style(
@@ -160,30 +162,31 @@ where
         progress.inc(1);
         objective + outside
     };
-    let counted = |u: &DVector<f64>| -> f64 {
-        let key: Vec<u64> = params.iter().zip(u.iter()).map(|(p, &u)| p.from_unit(u).to_bits()).collect();
-        let hit = cache.lock().unwrap_or_else(|p| p.into_inner()).contains_key(&key);
-        if hit {
-            reused.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-        }
-        objective(u)
-    };
     // The start first: the baseline every later candidate is compared with (and the first point of
     // the chart).
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
-    pool.install(|| counted(&DVector::from_vec(start.clone())));
-    let mut options = CMAESOptions::new(start, budget.step)
+    pool.install(|| objective(&DVector::from_vec(start.clone())));
+    // Whole generations only, so the budget never cuts one short: which candidates of a cut
+    // generation ran would depend on the threads' timing, and the search would not repeat.
+    let dim = params.len();
+    let mut lambda = budget.population.unwrap_or(4 + (3.0 * (dim as f64).ln()).floor() as usize);
+    let mut generations = (budget.evaluations - 1) / lambda;
+    if generations == 0 && budget.evaluations > 2 {
+        (lambda, generations) = (budget.evaluations - 1, 1);
+    }
+    let options = CMAESOptions::new(start, budget.step)
         .seed(budget.seed)
-        .max_function_evals(budget.evaluations)
+        .population_size(lambda.max(2))
+        .max_generations(generations.max(1))
         .tol_x(budget.tolerance)
         .tol_fun(1e-9)
         .tol_fun_hist(1e-9)
         .tol_stagnation(usize::MAX / 2);
-    if let Some(p) = budget.population {
-        options = options.population_size(p);
-    }
-    let mut cmaes = options.build(counted).map_err(|e| anyhow::anyhow!("the search cannot start: {e:?}"))?;
+    let mut cmaes = options.build(objective).map_err(|e| anyhow::anyhow!("the search cannot start: {e:?}"))?;
     let stop = pool.install(|| {
+        if generations == 0 {
+            return "the budget holds the start only".to_string();
+        }
         loop {
             let end = cmaes.next_parallel();
             if crate::interrupt::requested().is_some() {
@@ -211,12 +214,5 @@ where
         .as_ref()
         .and_then(EvalRecord::exact_values)
         .unwrap_or_else(|| params.iter().map(|p| p.start).collect());
-    Ok(SearchResult {
-        best,
-        best_record,
-        history,
-        reused: reused.into_inner(),
-        stop,
-        wall_time_s: started.elapsed().as_secs_f64(),
-    })
+    Ok(SearchResult { best, best_record, history, reused, stop, wall_time_s: started.elapsed().as_secs_f64() })
 }

@@ -5,7 +5,7 @@ use crate::run::scenario::PickPlaceScenario;
 use std::path::{Path, PathBuf};
 
 /// Columns `trace.csv` must have, as `tendril run` writes them (the order may differ).
-pub const REQUIRED_COLUMNS: [&str; 3] = ["time_s", "phase", "force_n"];
+pub const REQUIRED_COLUMNS: [&str; 4] = ["time_s", "phase", "force_n", "twine_motor_rad"];
 
 /// Why a recording cannot be used.
 #[derive(Debug, thiserror::Error)]
@@ -26,6 +26,8 @@ pub struct Tick {
     pub phase: String,
     /// Force estimate \[N\].
     pub force_n: f64,
+    /// Twine motor position \[rad\] (the tendon wound in).
+    pub twine_motor_rad: f64,
 }
 
 /// What happened in a run, as its summary says.
@@ -128,7 +130,7 @@ impl Recording {
 fn read_trace(path: &Path, rate_hz: f64) -> Result<Vec<Tick>, RecordingError> {
     let err = |reason: String| RecordingError { file: path.into(), reason };
     let table = crate::plot::input::Table::read(path).map_err(|e| err(e.to_string()))?;
-    let mut cols = [0usize; 3];
+    let mut cols = [0usize; 4];
     for (c, name) in cols.iter_mut().zip(REQUIRED_COLUMNS) {
         *c = table.header.iter().position(|h| h == name).ok_or_else(|| {
             err(format!(
@@ -146,10 +148,11 @@ fn read_trace(path: &Path, rate_hz: f64) -> Result<Vec<Tick>, RecordingError> {
         };
         let time_s = number(cols[0], "time_s")?;
         let force_n = number(cols[2], "force_n")?;
+        let twine_motor_rad = number(cols[3], "twine_motor_rad")?;
         if !time_s.is_finite() {
             return Err(err(format!("line {line}: column `time_s` is not finite")));
         }
-        ticks.push(Tick { time_s, phase: cells[cols[1]].clone(), force_n });
+        ticks.push(Tick { time_s, phase: cells[cols[1]].clone(), force_n, twine_motor_rad });
     }
     if ticks.len() < 2 {
         return Err(err("fewer than two ticks: nothing to fit".into()));

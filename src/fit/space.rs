@@ -138,39 +138,6 @@ pub fn parameters(
         .collect()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn spec(min: f64, max: f64, scale: Scale) -> ParameterSpec {
-        ParameterSpec { min, max, scale, start: None, integer: false }
-    }
-
-    #[test]
-    fn unit_round_trip_on_both_scales() {
-        let p = Parameter::from_spec("a", &spec(5.0, 60.0, Scale::Log)).unwrap();
-        assert!((p.start - (5.0f64 * 60.0).sqrt()).abs() < 1e-9, "{}", p.start);
-        for v in [5.0, 15.0, 60.0] {
-            assert!((p.from_unit(p.to_unit(v)) - v).abs() < 1e-9);
-        }
-        let q = Parameter::from_spec("b", &spec(0.6, 1.6, Scale::Linear)).unwrap();
-        assert!((q.from_unit(0.25) - 0.85).abs() < 1e-12);
-        assert_eq!(q.from_unit(-3.0), 0.6);
-        assert_eq!(q.from_unit(7.0), 1.6);
-    }
-
-    #[test]
-    fn bad_bounds_are_refused_with_the_reason() {
-        assert!(Parameter::from_spec("a", &spec(2.0, 1.0, Scale::Linear)).unwrap_err().contains("inverted"));
-        assert!(Parameter::from_spec("a", &spec(1.0, 1.0, Scale::Linear)).unwrap_err().contains("empty"));
-        assert!(Parameter::from_spec("a", &spec(0.0, 1.0, Scale::Log)).unwrap_err().contains("log"));
-        assert!(Parameter::from_spec("a", &spec(f64::NAN, 1.0, Scale::Linear)).unwrap_err().contains("finite"));
-        let mut s = spec(1.0, 2.0, Scale::Linear);
-        s.start = Some(3.0);
-        assert!(Parameter::from_spec("a", &s).unwrap_err().contains("outside"));
-    }
-}
-
 /// Checks that every parameter's bounds and start are valid values of its key in each scenario
 /// (`(file, table)`: where the scenario came from, its parsed table): a key that does not exist,
 /// or a bound outside the key's valid range, is an error naming `spec_file` and the parameter.
@@ -213,4 +180,37 @@ pub fn check_bounds(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(min: f64, max: f64, scale: Scale) -> ParameterSpec {
+        ParameterSpec { min, max, scale, start: None, integer: false }
+    }
+
+    #[test]
+    fn unit_round_trip_on_both_scales() {
+        let p = Parameter::from_spec("a", &spec(5.0, 60.0, Scale::Log)).unwrap();
+        assert!((p.start - (5.0f64 * 60.0).sqrt()).abs() < 1e-9, "{}", p.start);
+        for v in [5.0, 15.0, 60.0] {
+            assert!((p.from_unit(p.to_unit(v)) - v).abs() < 1e-9);
+        }
+        let q = Parameter::from_spec("b", &spec(0.6, 1.6, Scale::Linear)).unwrap();
+        assert!((q.from_unit(0.25) - 0.85).abs() < 1e-12);
+        assert_eq!(q.from_unit(-3.0), 0.6);
+        assert_eq!(q.from_unit(7.0), 1.6);
+    }
+
+    #[test]
+    fn bad_bounds_are_refused_with_the_reason() {
+        assert!(Parameter::from_spec("a", &spec(2.0, 1.0, Scale::Linear)).unwrap_err().contains("inverted"));
+        assert!(Parameter::from_spec("a", &spec(1.0, 1.0, Scale::Linear)).unwrap_err().contains("empty"));
+        assert!(Parameter::from_spec("a", &spec(0.0, 1.0, Scale::Log)).unwrap_err().contains("log"));
+        assert!(Parameter::from_spec("a", &spec(f64::NAN, 1.0, Scale::Linear)).unwrap_err().contains("finite"));
+        let mut s = spec(1.0, 2.0, Scale::Linear);
+        s.start = Some(3.0);
+        assert!(Parameter::from_spec("a", &s).unwrap_err().contains("outside"));
+    }
 }

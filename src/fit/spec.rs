@@ -10,9 +10,12 @@
 //! start = 15.0           # default: the middle of the range
 //! [objective]            # optional; these are the defaults
 //! force_rmse = 1.0       # [1/N]
+//! twine_motor = 2.0      # [1/rad]
 //! drop_time = 0.05       # [1/s]
 //! drop_phase = 0.05
 //! phases = ["grasp", "lift", "transfer", "lower"]
+//! smooth_s = 0.5         # [s] moving average both traces are compared through
+//! drop_margin_s = 1.0    # [s] not compared from this long before the first drop on
 //! [budget]               # optional; these are the defaults
 //! evaluations = 300
 //! step = 0.3
@@ -124,4 +127,30 @@ pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
         summaries.iter().zip(&recordings).map(|(f, r)| (f.as_path(), &r.table)).collect();
     super::space::check_bounds(file, &params, &scenarios)?;
     Ok(Fit { file: file.into(), recordings, params, weights: spec.objective, budget: spec.budget })
+}
+
+impl Fit {
+    /// Starts the search from the values `overlay` gives for the fit's parameters (a previous fit's
+    /// `overlay.toml`); with `evaluations = 1` the fit only scores those values against its
+    /// recordings, which is how held-out recordings are predicted. A value that is not a number
+    /// or lies outside the parameter's bounds is an error naming the overlay and the key.
+    pub fn start_from(&mut self, overlay: &crate::scenario::Overlay) -> Result<(), ScenarioError> {
+        let Some(file) = &overlay.file else { return Ok(()) };
+        for p in &mut self.params {
+            let Some(o) = overlay.overrides.iter().rev().find(|o| o.key == p.key) else { continue };
+            let v = match &o.value {
+                toml::Value::Float(v) => *v,
+                toml::Value::Integer(v) => *v as f64,
+                other => return Err(invalid(file, (p.key.clone(), format!("must be a number, got {other}")))),
+            };
+            if !(p.min..=p.max).contains(&v) {
+                return Err(invalid(
+                    file,
+                    (p.key.clone(), format!("{v} is outside the fit's bounds [{}, {}]", p.min, p.max)),
+                ));
+            }
+            p.start = v;
+        }
+        Ok(())
+    }
 }

@@ -176,6 +176,21 @@ pub struct LandscapeChart {
     pub best: Option<(f64, f64)>,
 }
 
+/// [`span`], with a margin by factor on a log axis of positive values (an additive one could go
+/// below zero).
+fn axis_span(values: impl Iterator<Item = f64> + Clone, log: bool) -> (f64, f64) {
+    let (lo, hi) = values
+        .clone()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if log && lo > 0.0 && hi.is_finite() {
+        let pad = (hi / lo).max(1.0 + 1e-9).powf(0.05);
+        (lo / pad, hi * pad)
+    } else {
+        span(values)
+    }
+}
+
 impl Chart for LandscapeChart {
     fn size(&self) -> (u32, u32) {
         (900, 760)
@@ -186,8 +201,8 @@ impl Chart for LandscapeChart {
         DB::ErrorType: 'static,
     {
         let root = root.titled(&self.title, (FONT, style::TITLE))?;
-        let (x0, x1) = span(self.points.iter().map(|p| p.0));
-        let (y0, y1) = span(self.points.iter().map(|p| p.1));
+        let (x0, x1) = axis_span(self.points.iter().map(|p| p.0), self.log.0);
+        let (y0, y1) = axis_span(self.points.iter().map(|p| p.1), self.log.1);
         let ok: Vec<f64> = self.points.iter().filter(|p| !p.3 && p.2.is_finite()).map(|p| p.2).collect();
         let (olo, ohi) = ok.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
         let shade = |v: f64| {
