@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 pub struct Overlay {
     /// The overlay file (`None`: no overlay, nothing changes).
     pub file: Option<PathBuf>,
-    /// Its keys and values, in file order.
+    /// Its keys and values, in key order (distinct keys: the order does not matter).
     pub overrides: Vec<Override>,
 }
 
@@ -101,7 +101,7 @@ mod tests {
         std::fs::write(&file, "\"finger.relaxation_time_s\" = 20.0\nseed = 3\n[object]\nfriction = 1.1\n").unwrap();
         let o = Overlay::load(Some(&file)).unwrap();
         let keys: Vec<&str> = o.overrides.iter().map(|o| o.key.as_str()).collect();
-        assert_eq!(keys, ["finger.relaxation_time_s", "seed", "object.friction"]);
+        assert_eq!(keys, ["finger.relaxation_time_s", "object.friction", "seed"]);
         let set: Override = "seed=4".parse().unwrap();
         let all = o.then(std::slice::from_ref(&set));
         assert_eq!(all.last(), Some(&set));
