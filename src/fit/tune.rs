@@ -320,8 +320,9 @@ fn evaluate(tune: &Tune, scenario: &TuneScenario, cases: &[Vec<Override>], value
     Evaluation { objective, failed, detail: serde_json::json!({ "runs": runs }) }
 }
 
-/// Runs every search of the tune into `out_dir`/<scenario>/[<type>/]; writes each scenario's best as
-/// `out_dir`/<scenario>/overlay.toml, a landscape chart per search and `out_dir`/tune.json.
+/// Runs every search of the tune into `out_dir/<scenario>/` (`out_dir/<scenario>/<type>/` with
+/// `controller_types`); writes each scenario's best as `out_dir/<scenario>/overlay.toml`, a
+/// landscape chart per search and `out_dir/tune.json`.
 pub fn run_tune(
     tune: &Tune,
     out_dir: &Path,
