@@ -34,7 +34,13 @@ pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
     let mut set = a.set.clone();
     set.extend(a.backend.map(Override::backend));
     let overrides = overlay.then(&set);
-    let rows = reproduce_rows(&a.what, &a.scenarios, &overrides)?;
+    // A bad overlay value is reported against the overlay, as on every other command.
+    let rows = reproduce_rows(&a.what, &a.scenarios, &overrides).map_err(|e| {
+        match e.downcast::<crate::scenario::ScenarioError>() {
+            Ok(e) => anyhow::Error::from(overlay.attribute(e, &set)),
+            Err(e) => e,
+        }
+    })?;
     emit(&render_table(&rows));
     if let Some(path) = a.json {
         write_file(&path, &(serde_json::to_string_pretty(&rows)? + "\n"))?;
