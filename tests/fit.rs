@@ -302,3 +302,35 @@ fn tune_finds_gains_per_object_and_writes_an_overlay_that_run_takes() {
     let o = tendril(&["tune", spec.to_str().unwrap(), "--out", dir.path().join("t2").to_str().unwrap()]);
     assert!(!o.status.success() && stderr(&o).contains("controller.kq"), "{}", stderr(&o));
 }
+
+#[test]
+fn a_candidate_whose_run_fails_scores_as_failed_and_the_fit_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    record(&dir.path().join("on"), "on", &[]);
+    // A divergence bound of 0.1 mm stops every run at the first contact ("physics failed").
+    let spec = dir.path().join("fit.toml");
+    std::fs::write(
+        &spec,
+        "recordings = [\"on\"]\n[parameters.\"physics.max_penetration_m\"]\nmin = 0.0001\nmax = 0.03\nscale = \"log\"\nstart = 0.0001\n\
+         [budget]\nevaluations = 9\npopulation = 8\nstep = 1.0\n",
+    )
+    .unwrap();
+    let out = dir.path().join("fit");
+    let o = tendril(&["fit", spec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let log = std::fs::read_to_string(out.join("evaluations.jsonl")).unwrap();
+    let records: Vec<serde_json::Value> = log.lines().skip(1).map(|l| serde_json::from_str(l).unwrap()).collect();
+    // Candidates below the bound are evaluated at it, once (the same point is not run twice).
+    assert!(
+        records.len() > 1 && records.len() <= 9,
+        "{} evaluations: the search went on past the failure",
+        records.len()
+    );
+    // The start is evaluated first, on its own.
+    let start = &records[0];
+    assert!((start["values"][0].as_f64().unwrap() - 0.0001).abs() < 1e-12, "{start}");
+    assert_eq!(start["failed"], true, "{start}");
+    assert_eq!(start["objective"], 1000.0);
+    let report = fit_json(&out);
+    assert_eq!(report["evaluations"].as_u64(), Some(records.len() as u64));
+}
