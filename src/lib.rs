@@ -16,6 +16,8 @@
 //! - [`control`]: what runs the same on the twin and on the real cell.
 //! - [`calibration`]: the paper's calibration procedures, for simulated or recorded bench data.
 //! - [`reproduce`]: the paper's figures next to the twin's.
+//! - [`fit`]: calibrating the twin to recorded runs (`tendril fit`) and tuning the controller on it
+//!   (`tendril tune`).
 //! - [`render`]: videos of finished runs (`tendril render`), from the MuJoCo states a run records.
 //! - [`mujoco_log`]: MuJoCo's warnings into our log and summaries (no `MUJOCO_LOG.TXT`).
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
@@ -27,6 +29,7 @@ pub mod calibration;
 pub mod cell;
 pub mod cli;
 pub mod control;
+pub mod fit;
 pub mod hardware;
 pub mod interrupt;
 pub mod mujoco_log;

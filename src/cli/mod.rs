@@ -2,6 +2,7 @@
 
 mod chart;
 mod devices;
+mod fit;
 mod latency;
 mod physics;
 mod plot;
@@ -12,6 +13,7 @@ mod run;
 mod sensor;
 mod serve;
 mod sweep;
+mod tune;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -38,6 +40,12 @@ enum Command {
     Render(render::RenderArgs),
     /// Run a sweep over scenario keys in parallel; writes DIR/results.csv as runs finish.
     Sweep(sweep::SweepArgs),
+    /// Calibrate the twin to recorded runs: search the scenario keys FIT.toml names for the values
+    /// whose runs best match the recordings; writes DIR/overlay.toml, DIR/fit.json and a chart.
+    Fit(fit::FitArgs),
+    /// Tune the controller on the twin: search gains, setpoint and controller keys per object for
+    /// the best hold, fluctuation, rise and overshoot; writes an overlay per object and charts.
+    Tune(tune::TuneArgs),
     /// Merge the results files of a sharded sweep into one.
     Merge(sweep::MergeArgs),
     /// Draw charts (PNG and SVG): a run directory's force trace, a sweep directory's heatmaps, or
@@ -74,6 +82,8 @@ pub fn main() -> ExitCode {
         Command::Render(a) => render::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Merge(a) => sweep::merge(a),
+        Command::Fit(a) => fit::run(a),
+        Command::Tune(a) => tune::run(a),
         Command::Plot(a) => plot::run(a),
         Command::Chart(a) => chart::run(a),
         Command::Calibrate(a) => sensor::calibrate(a),

@@ -20,15 +20,27 @@ pub struct ReproduceArgs {
     /// The twin's physics engine for Sec. V, `mujoco` or `rapier` (default: the scenarios' own).
     #[arg(long)]
     backend: Option<crate::cell::physics::Backend>,
+    /// Scenario keys from a file (what `tendril fit` and `tendril tune` write), applied to the Sec. V
+    /// scenarios after each file and before `--set`.
+    #[arg(long)]
+    overlay: Option<PathBuf>,
     /// Override a value of the Sec. V scenarios: `--set key.path=value` (repeatable).
     #[arg(long = "set")]
     set: Vec<Override>,
 }
 
 pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
-    let mut overrides = a.set.clone();
-    overrides.extend(a.backend.map(Override::backend));
-    let rows = reproduce_rows(&a.what, &a.scenarios, &overrides)?;
+    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let mut set = a.set.clone();
+    set.extend(a.backend.map(Override::backend));
+    let overrides = overlay.then(&set);
+    // A bad overlay value is reported against the overlay, as on every other command.
+    let rows = reproduce_rows(&a.what, &a.scenarios, &overrides).map_err(|e| {
+        match e.downcast::<crate::scenario::ScenarioError>() {
+            Ok(e) => anyhow::Error::from(overlay.attribute(e, &set)),
+            Err(e) => e,
+        }
+    })?;
     emit(&render_table(&rows));
     if let Some(path) = a.json {
         write_file(&path, &(serde_json::to_string_pretty(&rows)? + "\n"))?;

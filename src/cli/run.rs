@@ -22,6 +22,10 @@ pub struct RunArgs {
     /// Keep force control on while the arm moves (`on`) or switch it off before (`off`).
     #[arg(long, value_parser = ["on", "off"])]
     feedback: Option<String>,
+    /// Scenario keys from a file (what `tendril fit` and `tendril tune` write), applied after the
+    /// scenario file and before `--set`.
+    #[arg(long)]
+    overlay: Option<PathBuf>,
     /// Override a scenario value: `--set key.path=value` (repeatable), checked like the file.
     #[arg(long = "set")]
     set: Vec<Override>,
@@ -58,7 +62,8 @@ impl RunArgs {
 }
 
 pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
-    let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.overrides())?;
+    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.overrides())?;
     let dir = a.out.clone().unwrap_or_else(|| crate::run::output::default_run_dir(&scenario.name));
     // Ctrl-C, SIGTERM and SIGHUP: the safe stop, the trace whole and summary.json written.
     crate::interrupt::install()?;

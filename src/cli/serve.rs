@@ -25,6 +25,10 @@ pub struct ServeArgs {
     /// Stop after this many seconds, up to a week (default: until Ctrl-C, SIGTERM or SIGHUP).
     #[arg(long, value_parser = super::seconds_arg)]
     seconds: Option<f64>,
+    /// Scenario keys from a file (what `tendril fit` and `tendril tune` write), applied after the
+    /// scenario file and before `--set`.
+    #[arg(long)]
+    overlay: Option<PathBuf>,
     /// Override a scenario value: `--set key.path=value` (repeatable).
     #[arg(long = "set")]
     set: Vec<Override>,
@@ -33,7 +37,8 @@ pub struct ServeArgs {
 }
 
 pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
-    let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &a.set)?;
+    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.set)?;
     let mut config = ServeConfig::loopback();
     config.bind = a.bind;
     config.realtime = a.realtime.options()?;

@@ -23,6 +23,10 @@ pub struct SweepArgs {
     /// Skip the runs already in the results file and append the rest.
     #[arg(long)]
     resume: bool,
+    /// Scenario keys applied to every run from a file (what `tendril fit` and `tendril tune` write), applied after the
+    /// scenario file and before `--set`.
+    #[arg(long)]
+    overlay: Option<PathBuf>,
 }
 
 /// Most worker threads a sweep may ask for. Why: runs are CPU-bound and each holds its own
@@ -55,7 +59,8 @@ pub struct MergeArgs {
 }
 
 pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
-    let sweep = load_sweep(&a.sweep)?;
+    let mut sweep = load_sweep(&a.sweep)?;
+    sweep.overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
     let stem = a.sweep.file_stem().map_or("sweep".into(), |s| s.to_string_lossy().to_string());
     let options = SweepOptions {
         out_dir: a.out.unwrap_or_else(|| PathBuf::from("out").join(stem)),

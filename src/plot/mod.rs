@@ -5,6 +5,7 @@
 //! DejaVu Sans embedded in the binary, so PNGs render on a machine without system fonts.
 
 pub mod convergence;
+pub mod fit;
 pub mod gain_map;
 pub mod grid;
 pub mod input;

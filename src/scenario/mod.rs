@@ -3,15 +3,19 @@
 //! Every scenario type is read the same way ([`load`]): the file is parsed to a TOML table,
 //! `--set key=value` overrides are applied at their dotted paths ([`apply_overrides`]), the table is
 //! deserialised with unknown keys rejected, and the result is checked with [`Validate`]. Any
-//! failure is a [`ScenarioError`] that names the file, the dotted key and the reason.
+//! failure is a [`ScenarioError`] that names the file, the dotted key and the reason. An
+//! [`Overlay`] (`--overlay FILE`, what `tendril fit` and `tendril tune` write) is a file of such
+//! overrides, applied before the command line's.
 
 mod magnitude;
+mod overlay;
 mod overrides;
 mod paths;
 pub mod seed;
 mod validate;
 
 pub use magnitude::{MAX_MAGNITUDE, check_magnitudes};
+pub use overlay::Overlay;
 pub use overrides::{Override, apply_overrides};
 pub use validate::{Checker, Validate};
 

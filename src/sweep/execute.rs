@@ -72,8 +72,9 @@ pub fn check_runs(sweep: &Sweep) -> Result<(), crate::scenario::ScenarioError> {
             tables.insert(&run.scenario, table);
         }
         let mut table = tables[run.scenario.as_path()].clone();
-        let loaded = crate::scenario::apply_overrides(&mut table, &run.overrides)
-            .and_then(|()| crate::scenario::from_table::<PickPlaceScenario>(table, &run.scenario));
+        let loaded = crate::scenario::apply_overrides(&mut table, &sweep.overlay.then(&run.overrides))
+            .and_then(|()| crate::scenario::from_table::<PickPlaceScenario>(table, &run.scenario))
+            .map_err(|e| sweep.overlay.attribute(e, &run.overrides));
         match loaded {
             Ok(_) => {}
             Err(ScenarioError::Invalid { key, reason, .. }) if run.overrides.iter().any(|o| o.key == key) => {
@@ -98,9 +99,9 @@ fn list_sets(sweep: &Sweep, run: &SweepRun, key: &str) -> bool {
     run.list_index.is_some_and(|i| sweep.list_keys.get(i).is_some_and(|keys| keys.iter().any(|k| k == key)))
 }
 
-fn execute_one(run: &SweepRun, models: &ModelCache) -> RunSummary {
+fn execute_one(sweep: &Sweep, run: &SweepRun, models: &ModelCache) -> RunSummary {
     let name = run.scenario.file_stem().map_or("?".into(), |s| s.to_string_lossy().to_string());
-    let scenario = match crate::scenario::load::<PickPlaceScenario>(&run.scenario, &run.overrides) {
+    let scenario = match sweep.overlay.load_scenario::<PickPlaceScenario>(&run.scenario, &run.overrides) {
         Ok(s) => s,
         Err(e) => return RunSummary::failed_to_start(&name, e.to_string()),
     };
@@ -139,7 +140,7 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
                 if crate::interrupt::requested().is_some() || write_failed.load(std::sync::atomic::Ordering::SeqCst) {
                     return Ok(None);
                 }
-                let summary = execute_one(run, &models);
+                let summary = execute_one(sweep, run, &models);
                 // A run cut short by an operator stop is not done: no row, so --resume runs it.
                 if crate::interrupt::requested().is_some() {
                     return Ok(None);

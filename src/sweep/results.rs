@@ -53,7 +53,8 @@ pub fn identity_columns(sweep: &Sweep) -> usize {
 }
 
 /// The sweep's identity: 16 hex digits of a 64-bit FNV-1a hash of its expanded run list (each
-/// run's id, scenario file name and overrides). Every row carries it, so `--resume` and `merge`
+/// run's id, scenario file name and overrides, and the `--overlay`'s keys and values when there is
+/// one). Every row carries it, so `--resume` and `merge`
 /// refuse rows from another sweep whose columns happen to match. Scenario files are named by
 /// file name only, so resuming from another working directory is the same sweep.
 pub fn sweep_id(sweep: &Sweep) -> String {
@@ -71,6 +72,10 @@ pub fn sweep_id(sweep: &Sweep) -> String {
             feed(o.key.as_bytes());
             feed(o.value.to_string().as_bytes());
         }
+    }
+    for o in &sweep.overlay.overrides {
+        feed(o.key.as_bytes());
+        feed(o.value.to_string().as_bytes());
     }
     format!("{hash:016x}")
 }

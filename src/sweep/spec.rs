@@ -59,6 +59,8 @@ pub struct Sweep {
     pub list_keys: Vec<Vec<String>>,
     /// The runs, in id order.
     pub runs: Vec<SweepRun>,
+    /// `--overlay`: applied to every run before its own overrides (empty by default).
+    pub overlay: crate::scenario::Overlay,
 }
 
 fn invalid(file: &Path, key: &str, reason: impl Into<String>) -> ScenarioError {
@@ -119,7 +121,7 @@ pub fn load_sweep(file: &Path) -> Result<Sweep, ScenarioError> {
         }
     }
     let list_keys = spec.list.iter().map(|set| set.keys().cloned().collect()).collect();
-    Ok(Sweep { file: file.into(), keys, list_keys, runs })
+    Ok(Sweep { file: file.into(), keys, list_keys, runs, overlay: Default::default() })
 }
 
 /// Every combination of the grid's values, keys in order.
