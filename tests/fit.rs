@@ -15,8 +15,8 @@ const SCENARIO: &str = "scenarios/short-lift.toml";
 const LONG_LIFT: [&str; 2] = ["--set", "task.lift_s=10"];
 
 /// The "cell" the recordings come from: stiffer tendon path and slower relaxation than the twin's
-/// defaults (3000 N/m, 15 s).
-const TRUTH: [(&str, f64); 2] = [("finger.tendon_stiffness_n_m", 3600.0), ("finger.relaxation_time_s", 20.0)];
+/// defaults (6000 N/m, 15 s).
+const TRUTH: [(&str, f64); 2] = [("finger.tendon_stiffness_n_m", 7200.0), ("finger.relaxation_time_s", 20.0)];
 
 /// Records the short lift with the truth's values, feedback `on` or `off`, into `dir`.
 fn record(dir: &Path, feedback: &str, extra: &[&str]) {
@@ -41,7 +41,7 @@ fn fit_file(dir: &Path, recordings: &[&str], budget: usize) -> PathBuf {
     let list = recordings.iter().map(|r| format!("\"{r}\"")).collect::<Vec<_>>().join(", ");
     let text = format!(
         "recordings = [{list}]\n\
-         [parameters.\"finger.tendon_stiffness_n_m\"]\nmin = 1500.0\nmax = 6000.0\nscale = \"log\"\nstart = 3000.0\n\
+         [parameters.\"finger.tendon_stiffness_n_m\"]\nmin = 3000.0\nmax = 12000.0\nscale = \"log\"\nstart = 6000.0\n\
          [parameters.\"finger.relaxation_time_s\"]\nmin = 5.0\nmax = 60.0\nscale = \"log\"\nstart = 15.0\n\
          [budget]\nevaluations = {budget}\npopulation = 8\n"
     );
