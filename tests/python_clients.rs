@@ -42,7 +42,7 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
     let _turn = one_at_a_time();
     let Some(python) = python() else { return };
     // ur_rtde always connects to port 30004: a loopback address of its own avoids collisions.
-    let mut config = ServeConfig::loopback().with_port_base(39740);
+    let mut config = ServeConfig::loopback().with_port_base(21740);
     config.bind = IpAddr::V4(Ipv4Addr::new(127, 0, 0, 74));
     config.rtde_port = 30004;
     let serve = start(&short_lift(&[]), &config).unwrap();
@@ -76,7 +76,7 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
 fn dynamixel_sdk_pings_model_321_and_moves_the_growth_motor() {
     let _turn = one_at_a_time();
     let Some(python) = python() else { return };
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39750)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21750)).unwrap();
     let pty = serve.pty_path.to_string_lossy().to_string();
     let goal = 300; // ticks: 0.46 rad, 5.5 mm of finger growth on the 12 mm pinion
     let v = run_script(&python, "dynamixel_sdk_client.py", &[&pty, &goal.to_string()]);
@@ -93,7 +93,7 @@ fn dynamixel_sdk_pings_model_321_and_moves_the_growth_motor() {
 fn dynamixel_sdk_gets_the_manuals_status_errors_and_syncs_and_bulk_reads_the_moving_pair() {
     let _turn = one_at_a_time();
     let Some(python) = python() else { return };
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39760)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21760)).unwrap();
     let pty = serve.pty_path.to_string_lossy().to_string();
     let v = run_script(&python, "dynamixel_sdk_bus.py", &[&pty]);
     let (twin, tension) = {
@@ -139,7 +139,7 @@ fn twine_rad_matches(twin: &tendril::cell::real::serve::TwinStatus, ticks: i64) 
 fn ur_rtde_dashboard_client_drives_the_virtual_dashboard_server() {
     let _turn = one_at_a_time();
     let Some(python) = python() else { return };
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39870)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21870)).unwrap();
     let addr = serve.ur_addrs.dashboard;
     let v = run_script(&python, "ur_rtde_dashboard.py", &[&addr.ip().to_string(), &addr.port().to_string()]);
     let program = serve.state.lock().unwrap().program;

@@ -21,7 +21,7 @@ fn real_path_against_virtual_devices_matches_the_twin() {
     let (_, sim) = run_on_twin(&scenario, &Default::default(), None).unwrap();
     assert_eq!(sim.outcome, Outcome::Held, "the short scenario must hold on the twin: {:?}", sim.error);
 
-    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39710)).unwrap();
+    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(21710)).unwrap();
     let mut config = RealCellConfig::for_virtual_devices(&serve);
     // The watchdog itself is tested below.
     loose_watchdog(&mut config);
@@ -67,7 +67,7 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
     let _turn = one_at_a_time();
     use std::io::{Read, Write};
     let scenario = short_lift(&[]);
-    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39720)).unwrap();
+    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(21720)).unwrap();
     let timeout = Some(std::time::Duration::from_secs(2));
     // RTDE: a size field below the header length.
     let mut s = std::net::TcpStream::connect(serve.addrs[0]).unwrap();
@@ -100,7 +100,7 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
 #[test]
 fn a_stalled_sensor_stream_stops_the_run_with_a_watchdog_error() {
     let _turn = one_at_a_time();
-    let (serve, mut cell) = active_cell(39730, |_| {});
+    let (serve, mut cell) = active_cell(21730, |_| {});
     let s = cell.read().unwrap();
     assert!(s.wavelengths.fbg1_nm > 1500.0);
     // Stop the whole virtual cell: the stream goes silent.
@@ -117,7 +117,7 @@ fn a_silent_gripper_bus_neither_holds_up_the_tick_nor_goes_unnoticed() {
     let _turn = one_at_a_time();
     use std::time::Duration;
     // Only the motors' watchdog may fire while the devices are silenced.
-    let (serve, mut cell) = active_cell(39790, |config| {
+    let (serve, mut cell) = active_cell(21790, |config| {
         config.sensor_stale_samples = 1.0 / config.sensor_period_s;
         config.arm_stale_s = 1.0;
         config.dxl_reply_timeout = Duration::from_millis(250);
@@ -146,7 +146,7 @@ fn a_silent_gripper_bus_neither_holds_up_the_tick_nor_goes_unnoticed() {
 fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
     let _turn = one_at_a_time();
     use tendril::hardware::CellCommand;
-    let (serve, mut cell) = active_cell(39760, loose_watchdog);
+    let (serve, mut cell) = active_cell(21760, loose_watchdog);
     // Wind the twine motor for half a second, then stop as Ctrl-C does.
     for k in 1..=50 {
         let s = cell.read().unwrap();
@@ -193,7 +193,7 @@ fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
         "hardware.dxl_baud=1000000",
         "hardware.fbg.channel=3",
     ]);
-    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(39770)).unwrap();
+    let serve = start(&scenario, &ServeConfig::loopback().with_port_base(21770)).unwrap();
     {
         let s = serve.state.lock().unwrap();
         assert_eq!(s.bus.ids(), [11, 12]);
@@ -242,7 +242,7 @@ fn active_cell(port_base: u16, tune: impl FnOnce(&mut RealCellConfig)) -> (Serve
 fn idle_command_connections_are_closed() {
     let _turn = one_at_a_time();
     use std::io::{Read, Write};
-    let mut config = ServeConfig::loopback().with_port_base(39780);
+    let mut config = ServeConfig::loopback().with_port_base(21780);
     config.idle_timeout = std::time::Duration::from_millis(300);
     let serve = start(&short_lift(&[]), &config).unwrap();
     let mut buf = [0u8; 64];

@@ -54,7 +54,7 @@ impl Server {
 }
 
 /// Six consecutive free ports on loopback (serve's `--port-base N` takes N..N+5), away from the
-/// fixed bases of the in-process tests (397xx) and the devices' own ports.
+/// fixed bases of the in-process tests (217xx-218xx) and the devices' own ports.
 fn free_port_base() -> u16 {
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
     let seed = u64::from(std::process::id()) ^ now.as_nanos() as u64;

@@ -47,7 +47,7 @@ fn program(serve: &ServeHandle) -> ProgramState {
 #[test]
 fn the_dashboard_answers_as_the_controller_does_and_30003_takes_programs() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39850)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21850)).unwrap();
     let (mut d, greeting) = Dashboard::connect(serve.ur_addrs.dashboard);
     assert_eq!(greeting, "Connected: Universal Robots Dashboard Server");
     assert_eq!(d.ask("robotmode"), "Robotmode: RUNNING");
@@ -137,7 +137,7 @@ fn configure_error(serve: &ServeHandle, set: impl FnOnce(&mut tendril::cell::rea
 #[test]
 fn each_ur_precondition_failing_in_turn_is_named_by_the_real_path() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39860)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21860)).unwrap();
     let error = configure_error(&serve, |s| s.ur.remote_control = false);
     assert!(error.contains("not in remote control"), "{error}");
     let error = configure_error(&serve, |s| {

@@ -57,7 +57,7 @@ fn command(addr: SocketAddr, command: &str, argument: &str) -> Response {
 #[test]
 fn a_five_second_peak_stream_has_consecutive_serials_and_a_new_sample_in_each_frame() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39830)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21830)).unwrap();
     let frames = stream_for(serve.addrs[3], 5.0);
     let channel = serve.hardware.fbg.channel;
     // A loaded machine may run the twin slower than real time; it never skips a scan.
@@ -87,7 +87,7 @@ fn a_five_second_peak_stream_has_consecutive_serials_and_a_new_sample_in_each_fr
 #[test]
 fn the_streaming_divider_sends_every_tenth_scan_and_lunas_commands_are_answered() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39840)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21840)).unwrap();
     let commands = serve.addrs[2];
     assert_eq!(command(commands, "#SetPeakDataStreamingDivider", "10").status, 0);
     let frames = stream_for(serve.addrs[3], 1.0);

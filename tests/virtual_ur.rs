@@ -149,7 +149,7 @@ fn int(v: &RtdeValue) -> i64 {
 #[test]
 fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39800)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21800)).unwrap();
     upload(&serve, FOLLOW_SCRIPT);
     let outputs = [
         "timestamp",
@@ -247,7 +247,7 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
 #[test]
 fn hostile_targets_end_in_a_protective_stop_and_serve_keeps_serving() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39810)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21810)).unwrap();
     let watch =
         ["timestamp", "actual_q", "safety_mode", "safety_status", "runtime_state", "robot_mode", "safety_status_bits"];
     let mut observer = Rtde::start(serve.addrs[0], &watch, &[]);
@@ -297,7 +297,7 @@ fn hostile_targets_end_in_a_protective_stop_and_serve_keeps_serving() {
 #[test]
 fn a_client_that_stops_sending_stops_the_follow_program() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(39820)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21820)).unwrap();
     upload(&serve, FOLLOW_SCRIPT);
     let names = input_names();
     let inputs: Vec<&str> = names.iter().map(String::as_str).collect();
