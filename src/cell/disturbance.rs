@@ -204,14 +204,13 @@ impl PushConfig {
 pub struct DropoutConfig {
     /// Length of the gap \[s\].
     pub duration_s: f64,
-    /// Cell time of the start \[s\] (cell time counts from activation, 0 at the start of the
-    /// task); or give `phase`.
+    /// The start's cell time \[s\], as [`PushConfig::time_s`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_s: Option<f64>,
-    /// The phase whose start the onset counts from (`"lift"`, `"transfer"`...); or give `time_s`.
+    /// The start's phase, as [`PushConfig::phase`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phase: Option<Phase>,
-    /// Delay after the phase starts \[s\]; only with `phase`. Default 0.
+    /// The start's delay after the phase \[s\], as [`PushConfig::offset_s`].
     #[serde(default)]
     pub offset_s: f64,
 }

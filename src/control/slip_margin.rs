@@ -40,25 +40,19 @@ const G_M_S2: f64 = 9.80665;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SlipMarginConfig {
-    /// Proportional gain [(°/s)/N]. Paper: 20.
+    /// Proportional gain, as [`PidConfig::kp`].
     pub kp: f64,
-    /// Integral gain [(°/s)/(N·s)]. Paper: 0.05.
+    /// Integral gain, as [`PidConfig::ki`].
     pub ki: f64,
-    /// Derivative gain [(°/s)/(N/s)]. Paper: 0.
+    /// Derivative gain, as [`PidConfig::kd`].
     pub kd: f64,
-    /// Output limit [°/s], as the PID's (90 °/s).
+    /// Output limit, as [`PidConfig::max_speed_deg_s`].
     pub max_speed_deg_s: f64,
-    /// Derivative filter time constant \[s\], as the PID's.
+    /// Derivative filter time constant, as [`PidConfig::derivative_filter_s`].
     pub derivative_filter_s: f64,
-    /// Largest loosening speed while the arm moves [°/s] (the output is kept ≥ −this). A knock
-    /// on the object saturates the pad for a few tenths of a second; the PID reads that as a grip
-    /// far too tight and loosens at up to 60 °/s, and the object, knocked loose, then slips out
-    /// (on the twin the crimper survives a 0.3 N·s knock with the twine frozen, not with the
-    /// PID). Default 0: never loosen while the arm carries the object (the grip can only need
-    /// more while it moves; at the paper's limits without a knock the three objects' runs came
-    /// out the same with the clamp at 0, 2, 5 and 90 °/s, seed 1). The output limit switches the
-    /// clamp off. While the arm is still the PID's limit applies. The PID's integral is not told
-    /// of the clamp (at ki = 0.05 a 3 N spike for 0.3 s adds 0.05 °/s).
+    /// Largest loosening speed while the arm moves [°/s], as
+    /// [`FeedforwardConfig::max_release_deg_s`](super::feedforward::FeedforwardConfig::max_release_deg_s)
+    /// (why the default is 0 is told there).
     pub max_release_deg_s: f64,
     /// Margin the setpoint has over the friction limit at rest [-]. Default 0.05, a choice: the
     /// paper does not state one, and its crimper slipped at its setpoint without feedback, so the
