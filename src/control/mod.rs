@@ -5,6 +5,7 @@
 //! - [`hysteresis`]: Prandtl-Ishlinskii operators (forward model and its inverse).
 //! - [`gripper`]: motor angles to finger growth and tendon pull.
 //! - [`task`]: the pick-and-place sequence.
+//! - [`contact`]: first contact of the guarded close, robust to the sensor's noise.
 //! - [`controller`]: the force-controller seam ([`controller::ForceController`]) and `[controller]`.
 //! - [`pid`]: the paper's force controller, a PID (output: twine motor speed).
 //! - [`feedforward`]: the PID on a setpoint scheduled from the arm's planned motion.
@@ -12,6 +13,7 @@
 //! - [`trajectory`]: joint-space moves within the paper's speed and acceleration limits.
 //! - [`slip`]: slip and loss detection from the force estimate.
 
+pub mod contact;
 pub mod controller;
 pub mod estimate;
 pub mod feedforward;

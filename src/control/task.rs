@@ -4,6 +4,7 @@
 //! Each tick the sequencer takes the cell's state and the force estimate and returns the
 //! command. It never sees the true force: control runs on the sensor, as on the real cell.
 
+use super::contact::ContactDetector;
 use super::controller::{ArmMotion, ControlContext, ForceController, MoveOutlook};
 use super::gripper::GripperConfig;
 use super::trajectory::{JointLimits, JointMove};
@@ -93,6 +94,7 @@ pub struct TaskConfig {
     /// Rise of the force estimate above its unloaded reading that ends the guarded close \[N\]:
     /// first contact. 0.1 N is 40× the noise-limited resolution (paper: 2.57 mN), well clear of
     /// noise, and a sixth of the smallest setpoint (0.6 N), early enough to start force control.
+    /// Noisier readings are averaged and the threshold raised ([`super::contact`]).
     pub wrap_contact_n: f64,
     /// Longest guarded close \[s\]; past it the grasp starts anyway (and will likely fail).
     pub wrap_timeout_s: f64,
@@ -230,6 +232,8 @@ pub struct TaskSequencer {
     growth_m: f64,
     motion_start_s: Option<f64>,
     unloaded_n: f64,
+    /// First contact of the guarded close, robust to the estimate's noise.
+    contact: ContactDetector,
     /// The lift, planned when the grasp starts (what the controller is told is ahead).
     next_move: Option<JointMove>,
 }
@@ -250,6 +254,7 @@ impl TaskSequencer {
         setpoint_n: f64,
         feedback_while_moving: bool,
     ) -> Self {
+        let contact = ContactDetector::new(task.wrap_contact_n);
         TaskSequencer {
             task,
             gripper,
@@ -263,6 +268,7 @@ impl TaskSequencer {
             growth_m: 0.0,
             motion_start_s: None,
             unloaded_n: 0.0,
+            contact,
             next_move: None,
         }
     }
@@ -339,14 +345,14 @@ impl TaskSequencer {
         let now = state.time_s;
         let elapsed = now - self.phase_start_s;
         let arm_target = self.arm_move.as_ref().map(|m| m.end());
+        if self.phase == Phase::Home {
+            self.contact.observe_unloaded(force_n);
+        }
+        let touched = self.phase == Phase::Wrap && self.contact.touched(force_n - self.unloaded_n);
         let next = match self.phase {
             Phase::Home if elapsed >= self.task.settle_s => Some(Phase::Grow),
             Phase::Grow if self.growth_m >= self.task.growth_m => Some(Phase::Wrap),
-            Phase::Wrap
-                if force_n - self.unloaded_n >= self.task.wrap_contact_n || elapsed >= self.task.wrap_timeout_s =>
-            {
-                Some(Phase::Grasp)
-            }
+            Phase::Wrap if touched || elapsed >= self.task.wrap_timeout_s => Some(Phase::Grasp),
             Phase::Grasp if elapsed >= self.task.grasp_s => Some(Phase::Lift),
             Phase::Lift | Phase::Transfer | Phase::Lower
                 if self.arm_move.as_ref().is_some_and(|m| elapsed >= m.duration_s()) =>
