@@ -49,6 +49,7 @@ fn run_writes_trace_and_summary_with_the_documented_fields() {
         "overshoot_pct",
         "max_fluctuation_pct",
         "force_rmse_n",
+        "peak_force_n",
         "sim_time_s",
         "wall_time_s",
         "seed",

@@ -10,10 +10,10 @@ use std::process::ExitCode;
 #[derive(Debug, clap::Args)]
 pub struct ChartArgs {
     /// Which study: `convergence` (exits 1 when a convergence criterion breaks), `speed-accuracy`,
-    /// `stability` or `gain-map`.
-    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map"])]
+    /// `stability`, `gain-map` or `controllers` (each force controller under disturbances).
+    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers"])]
     study: String,
-    /// Scenario to study [default: convergence and gain-map the three objects; speed-accuracy the crimper (its fine reference drops it too, so
+    /// Scenario to study [default: convergence, gain-map and controllers the three objects; speed-accuracy the crimper (its fine reference drops it too, so
     /// drop times compare), stability the hammer (the heaviest load)].
     #[arg(long)]
     scenario: Vec<PathBuf>,
@@ -23,12 +23,13 @@ pub struct ChartArgs {
     /// A small grid, for a quick look.
     #[arg(long)]
     quick: bool,
-    /// Worker threads for the studies that do not time runs (convergence, stability, gain-map);
-    /// 0: one per core, at most 1024.
+    /// Worker threads for the studies that do not time runs (convergence, stability, gain-map,
+    /// controllers); 0: one per core, at most 1024.
     #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
-    /// Convergence: the seeds of every case.
-    #[arg(long, value_delimiter = ',', default_values_t = [1u64, 2, 3])]
+    /// Convergence and controllers: the seeds of every case [default: convergence 1,2,3;
+    /// controllers 1-10, with --quick 1,2].
+    #[arg(long, value_delimiter = ',')]
     seeds: Vec<u64>,
     /// Convergence: the physics backend (`mujoco` or `rapier`) [default: the scenario's].
     #[arg(long)]
@@ -69,12 +70,14 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             let steps: &[f64] = if a.quick { &[0.005, 0.04] } else { &study::stability::TIMESTEPS_S };
             study::stability::run(&first("scenarios/hammer.toml"), steps, &out, a.threads)?
         }
-        _ => {
+        "gain-map" => {
             let scenarios = objects_or(&a.scenario);
             let (kp, ki): (&[f64], &[f64]) =
                 if a.quick { (&[5.0, 20.0], &[0.05]) } else { (&study::gain_map::KP, &study::gain_map::KI) };
             study::gain_map::run(&scenarios, kp, ki, &out, a.threads)?
         }
+        "controllers" => controllers(&a, &out)?,
+        other => anyhow::bail!("unknown study `{other}`"),
     };
     for f in files {
         emit(&format!("{}\n", f.display()));
@@ -93,10 +96,11 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
     let base: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&scenarios[0], &extra)?;
     let (dt, links) = (base.physics.timestep_s, base.finger.segments);
     let plan = if a.quick { Plan::quick(dt, links) } else { Plan::full(dt, links) };
+    let seeds = if a.seeds.is_empty() { vec![1, 2, 3] } else { a.seeds.clone() };
     let cases: Vec<Case> = scenarios
         .into_iter()
         .flat_map(|scenario| {
-            let seeds = a.seeds.clone();
+            let seeds = seeds.clone();
             [true, false].into_iter().flat_map(move |feedback| {
                 let scenario = scenario.clone();
                 seeds.clone().into_iter().map(move |seed| Case { scenario: scenario.clone(), feedback, seed })
@@ -119,4 +123,37 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
         emit(&format!("  {case}, {pair}: {}\n", failed.join(", ")));
     }
     Ok((files, failures.is_empty()))
+}
+
+/// `tendril chart controllers`: each controller × object × disturbance set × seed; prints the
+/// summary as markdown and whether a controller meets the issue's goal. Returns the files written.
+fn controllers(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<Vec<PathBuf>> {
+    use crate::plot::controllers_summary::{GOAL_FLUCTUATION_PCT, controllers_meeting_goal, markdown};
+    use study::controllers::{GOAL_SET, Plan, run};
+    if let Some(seed) = a.seeds.iter().enumerate().find(|(i, s)| a.seeds[..*i].contains(s)).map(|(_, s)| s) {
+        anyhow::bail!("--seeds: seed {seed} is given twice (each seed is one run per case)");
+    }
+    if !a.set.is_empty() || a.backend.is_some() {
+        anyhow::bail!("--set and --backend apply to `chart convergence` only");
+    }
+    let plan = Plan::new(objects_or(&a.scenario), a.quick, &a.seeds);
+    let started = std::time::Instant::now();
+    let result = run(&plan, out, a.threads)?;
+    emit(&markdown(&result.summary));
+    let objects = crate::plot::grid::first_seen(result.summary.iter().map(|r| r.object.as_str())).len();
+    if plan.sets.iter().any(|s| s.name == GOAL_SET) {
+        let meeting = controllers_meeting_goal(&result.summary, GOAL_SET);
+        emit(&format!(
+            "\ngoal (every object held in every seed, largest fluctuation while moving <= {GOAL_FLUCTUATION_PCT} %, \
+             under `{GOAL_SET}`, {objects} object(s), {} seed(s)): {}\n",
+            plan.seeds.len(),
+            if meeting.is_empty() {
+                "met by no controller".to_string()
+            } else {
+                format!("met by {}", meeting.join(", "))
+            }
+        ));
+    }
+    emit(&format!("{} runs in {:.0} s wall\n", result.runs.len(), started.elapsed().as_secs_f64()));
+    Ok(result.files)
 }

@@ -49,10 +49,11 @@ enum Command {
     /// Merge the results files of a sharded sweep into one.
     Merge(sweep::MergeArgs),
     /// Draw charts (PNG and SVG): a run directory's force trace, a sweep directory's heatmaps, or
-    /// the charts of speed_accuracy.csv, stability.csv and gain_map.csv (a file or its folder).
+    /// the charts of speed_accuracy.csv, stability.csv, gain_map.csv and controllers.csv (a file
+    /// or its folder).
     Plot(plot::PlotArgs),
     /// Run a study over many runs and chart it: speed against accuracy, stability limits of the
-    /// integrators, or the (Kp, Ki) map of each object.
+    /// integrators, the (Kp, Ki) map of each object, or the force controllers under disturbances.
     Chart(chart::ChartArgs),
     /// Run the paper's calibration procedures on a bench CSV (columns: time_s, load_cell_n,
     /// fbg1_nm, fbg2_nm, temperature_c) and print the results.

@@ -1,9 +1,12 @@
 //! Charts (PNG and SVG) from files on disk: a run's trace, a sweep's heatmaps, the
-//! speed-against-accuracy scatter, the convergence panels, the stability dot matrix and the gain maps.
+//! speed-against-accuracy scatter, the convergence panels, the stability dot matrix, the gain maps and
+//! the controller study's bars.
 //!
 //! Every chart is drawn once per backend by a [`Chart`] so the PNG and the SVG agree. Text uses
 //! DejaVu Sans embedded in the binary, so PNGs render on a machine without system fonts.
 
+pub mod controllers;
+pub mod controllers_summary;
 pub mod convergence;
 pub mod fit;
 pub mod gain_map;
@@ -49,7 +52,10 @@ pub enum PlotError {
         message: String,
     },
     /// The path holds none of the files `tendril plot` knows.
-    #[error("{0}: no trace.csv, results.csv, speed_accuracy.csv, convergence.csv, stability.csv or gain_map.csv here")]
+    #[error(
+        "{0}: no trace.csv, results.csv, speed_accuracy.csv, convergence.csv, stability.csv, gain_map.csv or \
+         controllers.csv here"
+    )]
     NothingToPlot(String),
     /// Drawing failed (plotters backend error).
     #[error("{file}: drawing failed: {message}")]
@@ -104,7 +110,7 @@ pub fn save<C: Chart>(chart: &C, out_dir: &Path, stem: &str) -> Result<Vec<PathB
 ///
 /// PATH is a run directory (`trace.csv`, optional `summary.json`), a sweep directory
 /// (`results.csv`), a directory holding any of `speed_accuracy.csv`, `stability.csv`,
-/// `gain_map.csv`, or one of those files. Charts go to `out` (default: the directory of the input).
+/// `gain_map.csv`, `controllers.csv`, or one of those files. Charts go to `out` (default: the directory of the input).
 pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotError> {
     let (dir, only) = if path.is_file() {
         (
@@ -139,6 +145,9 @@ pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotEr
     }
     if wanted("gain_map.csv") {
         written.extend(gain_map::render(&gain_map::read(&dir.join("gain_map.csv"))?, &out_dir)?);
+    }
+    if wanted("controllers.csv") {
+        written.extend(controllers::render(&controllers::read(&dir.join("controllers.csv"))?, &out_dir)?);
     }
     if written.is_empty() {
         return Err(PlotError::NothingToPlot(path.display().to_string()));

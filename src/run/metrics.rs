@@ -23,6 +23,11 @@ pub struct ControlMetrics {
     /// reaching 90 % of the setpoint, the estimate swings across a ±10 % band around the
     /// setpoint at least [`OSCILLATION_SWINGS`] times.
     pub oscillating: bool,
+    /// Largest estimate from the start of the grasp to the release (or the drop), through the
+    /// same [`SPIKE_FILTER_TICKS`] median as the overshoot so that the pad's first-touch impact
+    /// does not count \[N\] (None when nothing was grasped). How hard the object was squeezed.
+    #[serde(default)]
+    pub peak_force_n: Option<f64>,
 }
 
 /// Swings across the ±10 % band that make a grasp count as oscillating: two full periods.
@@ -97,7 +102,18 @@ pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMe
     let force_rmse_n = (!compared.is_empty()).then(|| (compared.iter().sum::<f64>() / compared.len() as f64).sqrt());
     let settled: Vec<&TraceRow> = grasp.iter().copied().skip_while(|r| r.force_n < 0.9 * r.setpoint_n).collect();
     let oscillating = band_swings(&settled) >= OSCILLATION_SWINGS;
-    ControlMetrics { rise_time_90_s, overshoot_pct, max_fluctuation_pct, min_moving_force_n, force_rmse_n, oscillating }
+    let held: Vec<&TraceRow> =
+        rows.iter().filter(|r| r.phase.holding() && drop_time_s.is_none_or(|d| r.time_s < d)).collect();
+    let peak_force_n = despiked_force(&held).into_iter().reduce(f64::max);
+    ControlMetrics {
+        rise_time_90_s,
+        overshoot_pct,
+        max_fluctuation_pct,
+        min_moving_force_n,
+        force_rmse_n,
+        oscillating,
+        peak_force_n,
+    }
 }
 
 #[cfg(test)]
@@ -143,6 +159,11 @@ mod tests {
         assert!((m.force_rmse_n.unwrap() - 0.01).abs() < 1e-9);
         assert_eq!(control_metrics(&rows, Some(20.05)).max_fluctuation_pct, None);
         assert!(!m.oscillating);
+        // Over the grasp and the lift together: the single-tick 1.98 never passes the median; the
+        // window of the lift's first sample (cut to four at the trace's end: 1.96, 1.98, 0.75,
+        // 1.2) takes its upper middle, 1.96, the peak.
+        assert!((m.peak_force_n.unwrap() - 1.96).abs() < 1e-9, "{:?}", m.peak_force_n);
+        assert_eq!(control_metrics(&[], None).peak_force_n, None);
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! Studies over many runs: speed against accuracy, stability limits, gain maps.
+//! Studies over many runs: speed against accuracy, stability limits, gain maps, controllers.
 //!
 //! Each study loads one scenario with overrides per run, runs it on the twin, writes a CSV and
 //! draws its chart with [`crate::plot`].
@@ -7,7 +7,10 @@
 //! - [`speed_accuracy`]: timestep × integrator × cone × finger links against a fine reference.
 //! - [`stability`]: the largest stable timestep per integrator, and what fails past it.
 //! - [`gain_map`]: where in (Kp, Ki) the loop oscillates or loses the object, per object.
+//! - [`controllers`]: each force controller × object × disturbance set over seeds: held rate,
+//!   fluctuation, rise, overshoot, peak force.
 
+pub mod controllers;
 pub mod convergence;
 pub mod gain_map;
 pub mod speed_accuracy;
