@@ -78,7 +78,7 @@ fn bad_input_errors_before_any_window() {
     let err = one_line_failure(&out);
     assert!(err.contains("physics.backend = \"rapier\"") && err.contains("mujoco"), "{err}");
     for speed in ["0", "-2", "nan", "fast"] {
-        let (out, _) = view(&[SHORT_LIFT, "--speed", speed], None, Duration::from_secs(30));
+        let (out, _) = view(&[SHORT_LIFT, &format!("--speed={speed}")], None, Duration::from_secs(30));
         assert!(!out.status.success() && stderr(&out).contains("--speed"), "{speed}: {}", stderr(&out));
     }
 }
@@ -153,4 +153,46 @@ fn under_xvfb_a_bounded_session_steps_and_saves_a_screenshot() {
     colours.sort_unstable();
     colours.dedup();
     assert!(colours.len() > 50, "a blank picture: {} colours", colours.len());
+}
+
+/// The run loop's per-tick hook (what `tendril view` syncs through) sees every row, a hook that
+/// does nothing leaves the run as it was, and switching feedback off from it stops force control
+/// during the arm's moves.
+#[test]
+fn the_tick_hook_sees_every_tick_and_switches_feedback() {
+    use tendril::cell::physics::SceneModel;
+    use tendril::cell::sim::SimCell;
+    use tendril::control::task::Phase;
+    use tendril::run::runner::{run_task, run_task_observed};
+
+    let scenario = common::short_lift(&["feedback=true"]);
+    let plan = scenario.control_plan();
+    let model = SceneModel::build(&scenario.scene_spec()).unwrap();
+    let plain = run_task(&mut SimCell::for_scenario(&scenario, model.clone()), &plan, None);
+    let mut seen = 0;
+    let observed = run_task_observed(
+        &mut SimCell::for_scenario(&scenario, model.clone()),
+        &plan,
+        plan.controller.build(),
+        None,
+        &mut |_, _| seen += 1,
+    );
+    assert_eq!(seen, observed.rows.len());
+    assert_eq!(observed.rows, plain.rows, "a hook that does nothing changes nothing");
+    let moving = |rows: &[tendril::run::trace::TraceRow]| rows.iter().filter(|r| r.phase.arm_moving()).count();
+    assert!(moving(&plain.rows) > 10 && plain.rows.iter().any(|r| r.phase.arm_moving() && r.controller_on));
+
+    let switched = run_task_observed(
+        &mut SimCell::for_scenario(&scenario, model),
+        &plan,
+        plan.controller.build(),
+        None,
+        &mut |row, sequencer| {
+            if row.phase == Phase::Grasp {
+                sequencer.set_feedback(false);
+            }
+        },
+    );
+    assert!(moving(&switched.rows) > 10);
+    assert!(switched.rows.iter().filter(|r| r.phase.arm_moving()).all(|r| !r.controller_on), "feedback off");
 }

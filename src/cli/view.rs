@@ -88,7 +88,8 @@ pub fn run(a: ViewArgs) -> anyhow::Result<ExitCode> {
         report.ticks,
         report.frames
     ));
-    Ok(ExitCode::SUCCESS)
+    // Closing the window or the --seconds limit is a normal end; an operator stop is 128 + signal.
+    Ok(super::exit_for_runs(false))
 }
 
 #[cfg(test)]

@@ -374,18 +374,23 @@ fn panel(ui: &mut egui::Ui, status: &mut Status) {
         ui.monospace(panel_text(status));
         ui.horizontal(|ui| {
             let pause = if status.controls.paused { "Resume" } else { "Pause" };
-            if ui.button(pause).clicked() {
-                status.controls.apply(keys::Action::TogglePause);
-            }
-            if ui.button("Feedback").clicked() {
-                status.controls.apply(keys::Action::ToggleFeedback);
-            }
-            if ui.button("Knock").clicked() {
-                status.controls.apply(keys::Action::Knock);
+            for (label, action) in [
+                (pause, keys::Action::TogglePause),
+                ("Feedback", keys::Action::ToggleFeedback),
+                ("Knock", keys::Action::Knock),
+            ] {
+                let button = ui.button(label);
+                if button.clicked() {
+                    status.controls.apply(action);
+                }
+                // A focused button would also take Space as a click: the key would act twice.
+                if button.has_focus() {
+                    button.surrender_focus();
+                }
             }
         });
         let help: Vec<String> = keys::HELP.iter().map(|(k, what)| format!("{k}: {what}")).collect();
-        ui.small(format!("{}; double-click a body, then Ctrl + drag: push it", help.join(", ")));
+        ui.small(format!("{}; double-click a body, then Ctrl + Alt + drag: pull it", help.join(", ")));
     });
 }
 

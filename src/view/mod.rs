@@ -98,7 +98,9 @@ pub fn view(scenario: &PickPlaceScenario, opts: &ViewOptions) -> anyhow::Result<
     let model = SceneModel::build(&spec)?;
     let cell = SimCell::for_scenario(scenario, model);
     let mut live = LiveCell::open(cell, &display, &scenario.name, opts)?;
+    let plan = scenario.control_plan();
     let status = live.status();
+    status.borrow_mut().feedback = plan.feedback;
     let mut hook = move |row: &TraceRow, sequencer: &mut TaskSequencer| {
         let mut s = status.borrow_mut();
         if s.controls.take_feedback_switch() {
@@ -107,7 +109,6 @@ pub fn view(scenario: &PickPlaceScenario, opts: &ViewOptions) -> anyhow::Result<
         s.row = Some(*row);
         s.feedback = sequencer.feedback();
     };
-    let plan = scenario.control_plan();
     let report = run_task_observed(&mut live, &plan, plan.controller.build(), None, &mut hook);
     live.finished(report.outcome, report.error.as_deref());
     live.hold()?;

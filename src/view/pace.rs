@@ -62,20 +62,25 @@ mod tests {
         Duration::from_secs_f64(x)
     }
 
+    /// Equal to the microsecond (durations from decimal seconds round in the last nanosecond).
+    fn close(a: Duration, b: Duration) -> bool {
+        a.abs_diff(b) < Duration::from_micros(1)
+    }
+
     #[test]
     fn real_time_waits_out_the_cell_time() {
         let mut p = Pacer::new(1.0, s(10.0), 0.0);
-        assert_eq!(p.wait(s(10.0), 0.5), s(0.5));
-        assert_eq!(p.wait(s(10.2), 0.5), s(0.3));
+        assert!(close(p.wait(s(10.0), 0.5), s(0.5)));
+        assert!(close(p.wait(s(10.2), 0.5), s(0.3)));
         assert_eq!(p.wait(s(10.6), 0.5), Duration::ZERO, "late: no wait");
     }
 
     #[test]
     fn the_speed_factor_divides_the_wall_time() {
         let mut p = Pacer::new(2.0, s(0.0), 1.0);
-        assert_eq!(p.wait(s(0.0), 3.0), s(1.0), "2 cell seconds at 2x are 1 wall second");
+        assert!(close(p.wait(s(0.0), 3.0), s(1.0)), "2 cell seconds at 2x are 1 wall second");
         let mut slow = Pacer::new(0.5, s(0.0), 0.0);
-        assert_eq!(slow.wait(s(0.0), 1.0), s(2.0));
+        assert!(close(slow.wait(s(0.0), 1.0), s(2.0)));
     }
 
     #[test]
@@ -83,7 +88,7 @@ mod tests {
         let mut p = Pacer::new(1.0, s(0.0), 0.0);
         // Paused from wall 1 s to wall 5 s at cell time 1 s.
         p.restart(s(5.0), 1.0);
-        assert_eq!(p.wait(s(5.0), 1.1), s(0.1));
+        assert!(close(p.wait(s(5.0), 1.1), s(0.1)));
     }
 
     #[test]
@@ -91,10 +96,10 @@ mod tests {
         let mut p = Pacer::new(1.0, s(0.0), 0.0);
         // The physics fell 2 s behind: no burst, the next tick is paced from now.
         assert_eq!(p.wait(s(3.0), 1.0), Duration::ZERO);
-        assert_eq!(p.wait(s(3.0), 1.01), s(0.01));
+        assert!(close(p.wait(s(3.0), 1.01), s(0.01)));
         // A small lag is caught up on (no re-anchor).
         let mut q = Pacer::new(1.0, s(0.0), 0.0);
         assert_eq!(q.wait(s(1.1), 1.0), Duration::ZERO);
-        assert_eq!(q.wait(s(1.1), 1.15), s(0.05));
+        assert!(close(q.wait(s(1.1), 1.15), s(0.05)));
     }
 }
