@@ -11,7 +11,7 @@ use std::process::ExitCode;
 pub struct ViewArgs {
     /// The scenario file (scenarios/hammer.toml, ...).
     scenario: PathBuf,
-    /// Cell seconds per wall second: 1 is real time, 2 twice as fast, 0.5 half.
+    /// Cell seconds per wall second: 1 is real time, 2 twice as fast, 0.5 half (0.01 to 100).
     #[arg(long, default_value_t = 1.0, value_parser = speed_arg)]
     speed: f64,
     /// Close the window after this many wall seconds [default: when you close it].
