@@ -77,6 +77,10 @@ fn bad_input_errors_before_any_window() {
     let (out, _) = view(&[SHORT_LIFT, "--set", "physics.backend=\"rapier\""], None, Duration::from_secs(30));
     let err = one_line_failure(&out);
     assert!(err.contains("physics.backend = \"rapier\"") && err.contains("mujoco"), "{err}");
+    // The screenshot's folder is checked before the window opens.
+    let (out, _) = view(&[SHORT_LIFT, "--screenshot", "no/such/folder/shot.png"], None, Duration::from_secs(30));
+    let err = one_line_failure(&out);
+    assert!(err.contains("--screenshot no/such/folder/shot.png: no/such/folder: no such folder"), "{err}");
     for speed in ["0", "-2", "nan", "fast"] {
         let (out, _) = view(&[SHORT_LIFT, &format!("--speed={speed}")], None, Duration::from_secs(30));
         assert!(!out.status.success() && stderr(&out).contains("--speed"), "{speed}: {}", stderr(&out));

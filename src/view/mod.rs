@@ -88,11 +88,19 @@ pub struct ViewReport {
 
 /// Runs `scenario` on the twin in the live viewer until the window closes (or `opts.seconds`
 /// pass): the task once, then its final state on screen. Fails before any window when there is
-/// no display or the scenario's backend has no MuJoCo state.
+/// no display, the scenario's backend has no MuJoCo state or the screenshot's folder is missing.
 pub fn view(scenario: &PickPlaceScenario, opts: &ViewOptions) -> anyhow::Result<ViewReport> {
     let spec = scenario.scene_spec();
     if spec.physics.backend != Backend::Mujoco {
         return Err(ViewError::Backend(spec.physics.backend.name()).into());
+    }
+    if let Some(path) = &opts.screenshot {
+        // Checked before the window opens, not found out when it closes.
+        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        if !dir.is_dir() {
+            let cause = format!("{}: no such folder", dir.display());
+            return Err(ViewError::Screenshot { path: path.clone(), cause }.into());
+        }
     }
     let display = display::current_display().ok_or(ViewError::NoDisplay)?;
     let model = SceneModel::build(&spec)?;
