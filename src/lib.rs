@@ -19,6 +19,7 @@
 //! - [`fit`]: calibrating the twin to recorded runs (`tendril fit`) and tuning the controller on it
 //!   (`tendril tune`).
 //! - [`render`]: videos of finished runs (`tendril render`), from the MuJoCo states a run records.
+//! - [`view`]: the twin live in MuJoCo's interactive viewer (`tendril view`).
 //! - [`mujoco_log`]: MuJoCo's warnings into our log and summaries (no `MUJOCO_LOG.TXT`).
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
 //! - [`signals`]: the data types that cross the seam (wavelengths, ...).
@@ -42,3 +43,4 @@ pub mod sensor_bench;
 pub mod signals;
 pub mod study;
 pub mod sweep;
+pub mod view;

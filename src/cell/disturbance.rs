@@ -172,6 +172,20 @@ impl Validate for PushConfig {
 }
 
 impl PushConfig {
+    /// The knock `tendril view` applies when the scenario has no `[disturbance.push]`: the
+    /// issue's 0.3 N·s along world +y over the default 20 ms (its start is set when it is asked
+    /// for).
+    pub fn default_knock() -> PushConfig {
+        PushConfig {
+            impulse_n_s: 0.3,
+            direction_deg: 90.0,
+            duration_s: default_push_duration(),
+            time_s: None,
+            phase: None,
+            offset_s: 0.0,
+        }
+    }
+
     /// When the push starts.
     pub fn onset(&self) -> Onset {
         Onset { time_s: self.time_s, phase: self.phase, offset_s: self.offset_s }
@@ -239,12 +253,14 @@ impl DropoutConfig {
 pub struct DisturbanceSchedule {
     config: DisturbanceConfig,
     phase_starts: Vec<(Phase, f64)>,
+    /// Knocks asked for during the run ([`DisturbanceSchedule::knock`]), each with its start.
+    knocks: Vec<PushConfig>,
 }
 
 impl DisturbanceSchedule {
     /// A schedule for `config`, no phase started yet.
     pub fn new(config: DisturbanceConfig) -> Self {
-        DisturbanceSchedule { config, phase_starts: vec![] }
+        DisturbanceSchedule { config, phase_starts: vec![], knocks: vec![] }
     }
 
     /// Whether nothing is scheduled (the cell then runs exactly as without disturbances).
@@ -255,6 +271,18 @@ impl DisturbanceSchedule {
     /// Forgets the phases seen (a new run on the same cell).
     pub fn restart(&mut self) {
         self.phase_starts.clear();
+        self.knocks.clear();
+    }
+
+    /// Adds a knock starting at cell time `time_s` (`tendril view`'s key): the impulse, direction
+    /// and duration of the scenario's `[disturbance.push]`, or [`PushConfig::default_knock`]'s
+    /// when it has none. It comes on top of any scheduled push.
+    pub fn knock(&mut self, time_s: f64) {
+        let mut knock = self.config.push.unwrap_or_else(PushConfig::default_knock);
+        knock.time_s = Some(time_s);
+        knock.phase = None;
+        knock.offset_s = 0.0;
+        self.knocks.push(knock);
     }
 
     /// Records that the task entered `phase` at `time_s` (the first entry counts).
@@ -271,8 +299,19 @@ impl DisturbanceSchedule {
     /// The force on the object \[N\] for the physics step starting at `time_s` of length `dt_s`:
     /// the push's force on the `steps(dt_s)` steps from its onset (a step belongs to the push when
     /// its start lies within half a step of the push's span), zero otherwise.
+    /// Knocks ([`DisturbanceSchedule::knock`]) overlapping it add their force.
     pub fn push_force_n(&self, time_s: f64, dt_s: f64) -> Option<[f64; 3]> {
-        let push = self.config.push.as_ref()?;
+        let scheduled = self.config.push.as_ref().and_then(|push| self.one_push_force_n(push, time_s, dt_s));
+        self.knocks.iter().filter_map(|k| self.one_push_force_n(k, time_s, dt_s)).fold(scheduled, |sum, f| {
+            Some(match sum {
+                Some(s) => [s[0] + f[0], s[1] + f[1], s[2] + f[2]],
+                None => f,
+            })
+        })
+    }
+
+    /// The force of `push` alone on the step starting at `time_s`, if the step belongs to it.
+    fn one_push_force_n(&self, push: &PushConfig, time_s: f64, dt_s: f64) -> Option<[f64; 3]> {
         let start = self.start_of(&push.onset())?;
         let steps = push.steps(dt_s);
         let first = start - 0.5 * dt_s;
@@ -286,9 +325,9 @@ impl DisturbanceSchedule {
         self.start_of(&dropout.onset()).is_some_and(|start| time_s >= start && time_s < start + dropout.duration_s)
     }
 
-    /// Whether a push is configured.
+    /// Whether a push is configured or a knock was asked for.
     pub fn has_push(&self) -> bool {
-        self.config.push.is_some()
+        self.config.push.is_some() || !self.knocks.is_empty()
     }
 }
 
@@ -324,6 +363,39 @@ mod tests {
         }
         assert!(impulse[0].abs() < 1e-12 && (impulse[1] - 0.3).abs() < 1e-12, "{impulse:?}");
         assert!(s.push_force_n(12.0, dt).is_some() && s.push_force_n(12.02, dt).is_none());
+    }
+
+    #[test]
+    fn a_knock_adds_its_impulse_on_top_of_the_scheduled_push() {
+        let at = Onset { time_s: Some(2.0), phase: None, offset_s: 0.0 };
+        let mut s = DisturbanceSchedule::new(DisturbanceConfig { push: Some(push(at)), dropout: None });
+        let dt = 0.005;
+        s.knock(2.0);
+        s.knock(5.0);
+        let mut impulse = [0.0; 3];
+        for k in 0..2000 {
+            if let Some(f) = s.push_force_n(k as f64 * dt, dt) {
+                for i in 0..3 {
+                    impulse[i] += f[i] * dt;
+                }
+            }
+        }
+        // The scheduled push and two knocks of its size, one overlapping it.
+        assert!(impulse[0].abs() < 1e-12 && (impulse[1] - 0.9).abs() < 1e-12, "{impulse:?}");
+        assert!(s.push_force_n(5.0, dt).is_some() && s.push_force_n(4.0, dt).is_none());
+        s.restart();
+        assert!(s.push_force_n(5.0, dt).is_none(), "a restart forgets the knocks");
+    }
+
+    #[test]
+    fn without_a_push_a_knock_has_the_default_size() {
+        let mut s = DisturbanceSchedule::default();
+        assert!(!s.has_push());
+        s.knock(1.0);
+        assert!(s.has_push());
+        let dt = 0.005;
+        let total: f64 = (0..400).filter_map(|k| s.push_force_n(k as f64 * dt, dt)).map(|f| f[1] * dt).sum();
+        assert!((total - PushConfig::default_knock().impulse_n_s).abs() < 1e-12, "{total}");
     }
 
     #[test]

@@ -111,6 +111,26 @@ impl SimCell {
         self.sample_to_wait_time = true;
     }
 
+    /// The compiled scene model the cell runs on.
+    pub fn model(&self) -> &Arc<SceneModel> {
+        &self.model
+    }
+
+    /// The run's MuJoCo data (for `tendril view`'s viewer to show and perturb), once configured
+    /// and when the backend is MuJoCo.
+    pub fn mujoco_data_mut(&mut self) -> Option<&mut mujoco_rs::prelude::MjData<Arc<mujoco_rs::prelude::MjModel>>> {
+        self.scene.as_mut()?.mujoco_data_mut()
+    }
+
+    /// Knocks the object now (`tendril view`'s key): a push the size of the scenario's
+    /// `[disturbance.push]` (or [`super::disturbance::PushConfig::default_knock`]) from the next
+    /// physics step on. Returns the cell time of the knock, `None` before configuration.
+    pub fn knock(&mut self) -> Option<f64> {
+        let t = self.scene.as_ref()?.time();
+        self.disturbances.knock(t);
+        Some(t)
+    }
+
     /// A cell over a compiled scene model (shareable between runs). Nothing is simulated until
     /// [`Cell::configure`].
     pub fn new(

@@ -14,6 +14,7 @@ mod sensor;
 mod serve;
 mod sweep;
 mod tune;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -35,6 +36,10 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
     /// Run one pick-and-place scenario on the twin; writes DIR/trace.csv and DIR/summary.json.
     Run(run::RunArgs),
+    /// Run one scenario on the twin live in MuJoCo's interactive viewer: the controller in the
+    /// loop at real time (or --speed), keys to pause, switch feedback and knock the object, the
+    /// mouse to push it; needs a display.
+    View(view::ViewArgs),
     /// Render a finished run (its frames.bin) as an MP4 video with the force trace under the
     /// picture; offscreen through EGL, no display needed.
     Render(render::RenderArgs),
@@ -80,6 +85,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Reproduce(a) => reproduce::run(a),
         Command::Run(a) => run::run(a),
+        Command::View(a) => view::run(a),
         Command::Render(a) => render::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Merge(a) => sweep::merge(a),

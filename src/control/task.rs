@@ -289,6 +289,17 @@ impl TaskSequencer {
         self.setpoint_n
     }
 
+    /// Whether force control stays on while the arm moves (the paper's second mode).
+    pub fn feedback(&self) -> bool {
+        self.feedback_while_moving
+    }
+
+    /// Switches force control during the arm's moves on or off from the next tick on (a live
+    /// view's key); the grasp is always controlled.
+    pub fn set_feedback(&mut self, on: bool) {
+        self.feedback_while_moving = on;
+    }
+
     /// Cell time at which the arm started to move the object \[s\], once it has.
     pub fn motion_start_s(&self) -> Option<f64> {
         self.motion_start_s

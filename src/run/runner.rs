@@ -104,7 +104,23 @@ pub fn run_task_with_controller(
     cell: &mut dyn Cell,
     plan: &ControlPlan,
     controller: Box<dyn ForceController>,
+    trace: Option<&mut TraceWriter>,
+) -> RunReport {
+    run_task_observed(cell, plan, controller, trace, &mut |_, _| {})
+}
+
+/// Called once per control tick, after the tick's row is written and before the cell waits for
+/// the next tick: a live view (`tendril view`) shows the row and may steer the sequencer (switch
+/// force feedback). A hook that does nothing leaves the run exactly as [`run_task_with_controller`].
+pub type TickHook<'a> = dyn FnMut(&TraceRow, &mut TaskSequencer) + 'a;
+
+/// As [`run_task_with_controller`], with `hook` called on every tick (see [`TickHook`]).
+pub fn run_task_observed(
+    cell: &mut dyn Cell,
+    plan: &ControlPlan,
+    controller: Box<dyn ForceController>,
     mut trace: Option<&mut TraceWriter>,
+    hook: &mut TickHook<'_>,
 ) -> RunReport {
     let mut rows = Vec::new();
     let mut sequencer = TaskSequencer::new(plan.task.clone(), plan.gripper, controller, plan.setpoint_n, plan.feedback);
@@ -192,6 +208,7 @@ pub fn run_task_with_controller(
             if let Some(w) = trace.as_deref_mut() {
                 w.write(&row).map_err(|e| CellError::Device { device: "trace".into(), cause: e.to_string() })?;
             }
+            hook(&row, &mut sequencer);
             rows.push(row);
             if decision.phase == Phase::Done {
                 return Ok(());

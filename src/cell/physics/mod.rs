@@ -76,6 +76,14 @@ pub trait Physics: Send {
         None
     }
 
+    /// The run's MuJoCo data, for a live viewer to show and perturb (`tendril view`); `None` when
+    /// the backend has no MuJoCo state.
+    fn mujoco_data_mut(
+        &mut self,
+    ) -> Option<&mut mujoco_rs::prelude::MjData<std::sync::Arc<mujoco_rs::prelude::MjModel>>> {
+        None
+    }
+
     /// Steps for `seconds` of simulated time (rounded to whole steps).
     fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
         let n = (seconds / self.timestep()).round() as usize;

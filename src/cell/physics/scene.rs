@@ -416,6 +416,10 @@ impl Physics for Scene {
         })
     }
 
+    fn mujoco_data_mut(&mut self) -> Option<&mut MjData<Arc<MjModel>>> {
+        Some(&mut self.data)
+    }
+
     fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
         self.drive.set_growth(growth_m)
     }
