@@ -152,3 +152,36 @@ fn a_run_without_frames_is_an_error_naming_the_file() {
     assert!(err.contains("frames.bin: no such file"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
 }
+
+#[test]
+fn run_with_video_renders_the_run_when_it_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_dir = dir.path().join("run");
+    let run = tendril(&["run", "scenarios/short-lift.toml", "--out", run_dir.to_str().unwrap(), "--video"]);
+    assert!(run.status.success(), "run --video failed (needs EGL): {}", stderr(&run));
+    let out = String::from_utf8_lossy(&run.stdout);
+    assert!(out.contains("video.mp4"), "the run says it wrote the video: {out}");
+    // tendril render's defaults: 640 wide, 30 frames per second of cell time.
+    let (pictures, width, _) = decode(&run_dir.join("video.mp4"));
+    let last = *FrameLog::read(&run_dir.join(FRAMES_FILE)).unwrap().times.last().unwrap();
+    assert_eq!(width, 640);
+    assert_eq!(pictures.len(), tendril::render::frame_count(last, 30.0, 1.0));
+}
+
+#[test]
+fn run_with_video_on_the_real_cell_is_refused_before_it_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tendril(&[
+        "run",
+        "scenarios/short-lift.toml",
+        "--hardware",
+        "real",
+        "--video",
+        "--out",
+        dir.path().join("run").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("--video") && err.contains("real cell records none"), "{err}");
+    assert!(!dir.path().join("run").exists(), "nothing ran");
+}

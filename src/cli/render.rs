@@ -60,7 +60,14 @@ pub fn run(a: RenderArgs) -> anyhow::Result<ExitCode> {
         panel: !a.no_panel,
         still_s: a.still,
     };
-    let stats = render_run(&a.run_dir, &opts)?;
+    render_and_report(&a.run_dir, &opts)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Renders `run_dir` with `opts` and prints what was written and how fast (also `tendril run
+/// --video`).
+pub(super) fn render_and_report(run_dir: &std::path::Path, opts: &RenderOptions) -> anyhow::Result<()> {
+    let stats = render_run(run_dir, opts)?;
     super::emit(&format!(
         "wrote {} ({} frames, {}x{}, {:.1} s of cell time, {:.0} kB) in {:.1} s: {:.1} frames/s, {:.2} cell s per s\n",
         opts.out.display(),
@@ -73,5 +80,5 @@ pub fn run(a: RenderArgs) -> anyhow::Result<ExitCode> {
         stats.frames_per_s(),
         stats.cell_s_per_s()
     ));
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }

@@ -39,6 +39,10 @@ pub struct RunArgs {
     /// Which cell runs the task: the twin (`sim`) or the devices (`real`).
     #[arg(long, value_parser = ["sim", "real"], default_value = "sim")]
     hardware: String,
+    /// When the run ends, also render it as OUT/video.mp4 with `tendril render`'s defaults (the
+    /// twin only: the real cell records no frames).
+    #[arg(long)]
+    video: bool,
     #[command(flatten)]
     devices: super::devices::DeviceArgs,
 }
@@ -65,6 +69,9 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
     let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.overrides())?;
     let dir = a.out.clone().unwrap_or_else(|| crate::run::output::default_run_dir(&scenario.name));
+    if a.video && a.hardware == "real" {
+        anyhow::bail!("--video renders the twin's recorded frames; the real cell records none (leave out --video)");
+    }
     // Ctrl-C, SIGTERM and SIGHUP: the safe stop, the trace whole and summary.json written.
     crate::interrupt::install()?;
     let (summary, _) = if a.hardware == "real" {
@@ -83,5 +90,10 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         String::new()
     };
     emit(&format!("wrote {0}/trace.csv, {0}/summary.json{frames} and {0}/scenario.toml\n", dir.display()));
+    if a.video {
+        // A run that ended in an error still rendered up to its last recorded frame.
+        let opts = crate::render::RenderOptions { out: dir.join("video.mp4"), ..Default::default() };
+        super::render::render_and_report(&dir, &opts)?;
+    }
     Ok(super::exit_for_runs(summary.outcome == "error"))
 }
