@@ -10,6 +10,7 @@ mod realtime;
 mod render;
 mod reproduce;
 mod run;
+mod scenario_args;
 mod sensor;
 mod serve;
 mod sweep;

@@ -11,31 +11,14 @@ use std::process::ExitCode;
 /// Arguments of `tendril run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// The scenario file (scenarios/crimper.toml, ...).
-    scenario: PathBuf,
+    #[command(flatten)]
+    scenario: super::scenario_args::ScenarioArgs,
     /// Output folder [default: out/<scenario name>].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Seed of the sensor noise (same scenario and seed: identical trace).
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Keep force control on while the arm moves (`on`) or switch it off before (`off`).
-    #[arg(long, value_parser = ["on", "off"])]
-    feedback: Option<String>,
-    /// Scenario keys from a file (what `tendril fit` and `tendril tune` write), applied after the
-    /// scenario file and before `--set`.
-    #[arg(long)]
-    overlay: Option<PathBuf>,
-    /// Override a scenario value: `--set key.path=value` (repeatable), checked like the file.
-    #[arg(long = "set")]
-    set: Vec<Override>,
     /// The twin's physics engine, `mujoco` or `rapier` (the scenario's `physics.backend`).
     #[arg(long)]
     backend: Option<crate::cell::physics::Backend>,
-    /// Folder of the scene's model parts (finger.xml, ur5e.xml, ...) [default: models/ beside the
-    /// scenario's folder, else the built-in copies]; `physics.models_dir`.
-    #[arg(long)]
-    models: Option<PathBuf>,
     /// Which cell runs the task: the twin (`sim`) or the devices (`real`).
     #[arg(long, value_parser = ["sim", "real"], default_value = "sim")]
     hardware: String,
@@ -48,26 +31,16 @@ pub struct RunArgs {
 }
 
 impl RunArgs {
-    /// `--seed`, `--feedback` and `--dxl-baud` are overrides like any `--set`, so they are
-    /// validated alike.
+    /// `--dxl-baud` and `--backend` are overrides like any `--set`, so they are validated alike.
     fn overrides(&self) -> Vec<Override> {
-        let mut o = self.set.clone();
-        o.extend(self.devices.overrides());
-        if let Some(seed) = self.seed {
-            o.push(Override { key: "seed".into(), value: crate::scenario::seed::to_toml(seed) });
-        }
-        if let Some(f) = &self.feedback {
-            o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
-        }
-        o.extend(self.backend.map(Override::backend));
-        o.extend(self.models.as_deref().map(Override::models_dir));
-        o
+        let mut extra = self.devices.overrides();
+        extra.extend(self.backend.map(Override::backend));
+        extra
     }
 }
 
 pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
-    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
-    let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.overrides())?;
+    let scenario: PickPlaceScenario = a.scenario.load(a.overrides())?;
     let dir = a.out.clone().unwrap_or_else(|| crate::run::output::default_run_dir(&scenario.name));
     if a.video && a.hardware == "real" {
         anyhow::bail!("--video renders the twin's recorded frames; the real cell records none (leave out --video)");
