@@ -27,7 +27,7 @@ use std::collections::VecDeque;
 /// 3500 closes; 4 would be once in 100.
 pub const Z: f64 = 5.0;
 
-/// Longest averaging window [ticks]. 25 ticks is 0.25 s at 100 Hz, in which the close (15 °/s)
+/// Longest averaging window \[ticks\]. 25 ticks is 0.25 s at 100 Hz, in which the close (15 °/s)
 /// winds 3.75° more tendon; beyond it the threshold is raised instead (30 pm: 0.13 N).
 pub const MAX_WINDOW_TICKS: usize = 25;
 
