@@ -167,23 +167,10 @@ pub fn trace_rmse(
     Some((raw, smoothed))
 }
 
-/// Centred moving average over `window` samples (shorter at the ends); `window` ≤ 1 copies.
+/// Centred moving average over `window` samples (shorter at the ends), the calibration's
+/// [`smooth`](crate::calibration::smooth) over `window / 2` each side; `window` ≤ 1 copies.
 fn moving_average(x: &[f64], window: usize) -> Vec<f64> {
-    if window <= 1 {
-        return x.to_vec();
-    }
-    let mut prefix = Vec::with_capacity(x.len() + 1);
-    prefix.push(0.0);
-    for v in x {
-        prefix.push(prefix.last().copied().unwrap_or(0.0) + v);
-    }
-    let half = window / 2;
-    (0..x.len())
-        .map(|i| {
-            let (a, b) = (i.saturating_sub(half), (i + half + 1).min(x.len()));
-            (prefix[b] - prefix[a]) / (b - a) as f64
-        })
-        .collect()
+    if window <= 1 { x.to_vec() } else { crate::calibration::smooth(x, window / 2) }
 }
 
 /// Compares a simulated run (`rows`, `events`) with a recording (`ticks`, `recorded`).

@@ -170,6 +170,28 @@ fn no_gl(e: &RendererError) -> anyhow::Error {
     )
 }
 
+/// Dresses `model`, a copy of `scene`'s, for the screen as `tendril render` and `tendril view`
+/// show it: a brighter headlight (the scene's own lights leave the arm and the hand dark) and the
+/// sensor pad in orange.
+pub(crate) fn dress_for_screen(model: &mut MjModel, scene: &SceneModel) {
+    let vis = model.vis_mut();
+    vis.headlight.ambient = [0.35, 0.35, 0.35];
+    vis.headlight.diffuse = [0.6, 0.6, 0.6];
+    for &g in &scene.ids().pad_geoms {
+        model.geom_rgba_mut()[g] = [1.0, 0.45, 0.0, 1.0];
+    }
+}
+
+/// Where the free camera looks in `data`'s state: the object's grip, or the hand when the scene
+/// has no object.
+pub(crate) fn camera_target(scene: &SceneModel, data: &MjData<Arc<MjModel>>) -> [f64; 3] {
+    let ids = scene.ids();
+    match ids.object_grip {
+        Some(g) => data.geom_xpos()[g],
+        None => data.xpos()[ids.hand_body],
+    }
+}
+
 /// Renders the run in `run_dir` (its `frames.bin`, `scenario.toml` and, for the panel,
 /// `trace.csv`) to `opts.out`.
 pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<RenderStats> {
@@ -213,13 +235,8 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
         // Contact force arrows: 2 cm per newton (the grip is a few newtons), thinner than default.
         vis.map.force = 0.02;
         vis.scale.forcewidth = 0.02;
-        // A brighter headlight: the scene's own lights leave the arm and the hand dark.
-        vis.headlight.ambient = [0.35, 0.35, 0.35];
-        vis.headlight.diffuse = [0.6, 0.6, 0.6];
     }
-    for &g in &scene.ids().pad_geoms {
-        model.geom_rgba_mut()[g] = [1.0, 0.45, 0.0, 1.0];
-    }
+    dress_for_screen(&mut model, &scene);
     let model = Arc::new(model);
     let mut data = MjData::new(model.clone());
 
@@ -241,11 +258,7 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
             let mut cam = MjvCamera::new_free(&model);
             set_state(&mut data, &log, 0, &model);
             data.forward();
-            let ids = scene.ids();
-            cam.lookat = match ids.object_grip {
-                Some(g) => data.geom_xpos()[g],
-                None => data.xpos()[ids.hand_body],
-            };
+            cam.lookat = camera_target(&scene, &data);
             cam.distance = opts.distance_m;
             cam.azimuth = opts.azimuth_deg;
             cam.elevation = opts.elevation_deg;

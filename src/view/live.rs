@@ -332,22 +332,14 @@ pub const CAMERA_DISTANCE_M: f64 = 0.6;
 fn viewer_model(sim: &SimCell) -> mujoco_rs::prelude::MjModel {
     let shared = sim.model();
     let start = crate::cell::physics::Scene::new(shared.clone());
-    let ids = shared.ids();
-    let lookat = match ids.object_grip {
-        Some(g) => start.data().geom_xpos()[g],
-        None => start.data().xpos()[ids.hand_body],
-    };
     let mut model = (**shared.model()).clone();
-    model.stat_mut().center = lookat;
+    model.stat_mut().center = crate::render::camera_target(shared, start.data());
     model.stat_mut().extent = CAMERA_DISTANCE_M / 1.5;
+    let render = crate::render::RenderOptions::default();
     let vis = model.vis_mut();
-    vis.global.azimuth = 135.0;
-    vis.global.elevation = -20.0;
-    vis.headlight.ambient = [0.35, 0.35, 0.35];
-    vis.headlight.diffuse = [0.6, 0.6, 0.6];
-    for &g in &ids.pad_geoms {
-        model.geom_rgba_mut()[g] = [1.0, 0.45, 0.0, 1.0];
-    }
+    vis.global.azimuth = render.azimuth_deg as f32;
+    vis.global.elevation = render.elevation_deg as f32;
+    crate::render::dress_for_screen(&mut model, shared);
     model
 }
 
