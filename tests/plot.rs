@@ -114,7 +114,7 @@ max_fluctuation_pct,min_moving_force_n,force_rmse_n,sim_time_s,wall_time_s,real_
 
 fn write_speed_accuracy(dir: &Path) {
     let mut s = String::from(
-        "backend,integrator,cone,timestep_s,segments,sim_s_per_wall_s,force_rmse_n,drop_time_error_s,status,is_default,is_reference\n",
+        "backend,integrator,cone,timestep_s,segments,sim_s_per_cpu_s,force_rmse_n,drop_time_error_s,status,is_default,is_reference\n",
     );
     for (k, integrator) in ["Euler", "implicitfast", "implicit", "RK4"].iter().enumerate() {
         for dt in [0.0005, 0.001, 0.002, 0.005] {
@@ -247,11 +247,11 @@ fn speed_accuracy_chart_and_front() {
     assert!(front.len() >= 2);
     // No point on the front is beaten on both counts by any plotted point.
     for i in &front {
-        let (s, e) = (rows[*i].sim_s_per_wall_s.unwrap(), rows[*i].force_rmse_n.unwrap());
+        let (s, e) = (rows[*i].sim_s_per_cpu_s.unwrap(), rows[*i].force_rmse_n.unwrap());
         assert!(
             rows.iter()
                 .filter(|r| r.status == "ok" && r.force_rmse_n.unwrap_or(0.0) > 0.0)
-                .all(|r| { !(r.sim_s_per_wall_s.unwrap() > s && r.force_rmse_n.unwrap() < e) })
+                .all(|r| { !(r.sim_s_per_cpu_s.unwrap() > s && r.force_rmse_n.unwrap() < e) })
         );
     }
     // Diverged and reference (zero error) rows are never on the front.

@@ -23,8 +23,8 @@ pub struct ChartArgs {
     /// A small grid, for a quick look.
     #[arg(long)]
     quick: bool,
-    /// Worker threads for the studies that do not time runs (convergence, stability, gain-map,
-    /// controllers); 0: one per core, at most 1024.
+    /// Worker threads; 0: one per core, at most 1024. Speeds are each run's own CPU time, so runs
+    /// side by side do not slow each other's figures (beyond shared caches).
     #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
     /// Convergence and controllers: the seeds of every case [default: convergence 1,2,3;
@@ -64,7 +64,7 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             let grid = if a.quick { study::speed_accuracy::Grid::quick() } else { study::speed_accuracy::Grid::full() };
             let p = PhysicsConfig::default();
             let defaults = (p.timestep_s, "implicitfast", "elliptic", FingerConfig::default().segments);
-            study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, defaults, &out)?
+            study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, defaults, &out, a.threads)?
         }
         "stability" => {
             let steps: &[f64] = if a.quick { &[0.005, 0.04] } else { &study::stability::TIMESTEPS_S };

@@ -24,8 +24,8 @@ pub struct SpeedAccuracyRow {
     pub timestep_s: f64,
     /// Finger links.
     pub segments: u32,
-    /// Simulated seconds per wall-clock second (None if the run failed before measuring).
-    pub sim_s_per_wall_s: Option<f64>,
+    /// Simulated seconds per CPU second of the run's thread (None if the run failed before measuring).
+    pub sim_s_per_cpu_s: Option<f64>,
     /// RMSE of the sensor force against the reference run \[N\].
     pub force_rmse_n: Option<f64>,
     /// Drop-time error against the reference \[s\] (None when neither dropped).
@@ -45,7 +45,7 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
     let (backend, integrator, cone, dt, segs) =
         (c("backend")?, c("integrator")?, c("cone")?, c("timestep_s")?, c("segments")?);
     let (speed, rmse, drop, status) =
-        (c("sim_s_per_wall_s")?, c("force_rmse_n")?, c("drop_time_error_s")?, c("status")?);
+        (c("sim_s_per_cpu_s")?, c("force_rmse_n")?, c("drop_time_error_s")?, c("status")?);
     let (default, reference) = (c("is_default")?, c("is_reference")?);
     let rows = t
         .iter()
@@ -59,7 +59,7 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
                 segments: segments
                     .parse()
                     .map_err(|_| r.error(format!("column `segments`: `{segments}` is not a whole number")))?,
-                sim_s_per_wall_s: r.opt_f64(speed)?,
+                sim_s_per_cpu_s: r.opt_f64(speed)?,
                 force_rmse_n: r.opt_f64(rmse)?,
                 drop_time_error_s: r.opt_f64(drop)?,
                 status: r.one_of(status, &["ok", "diverged", "error"])?,
@@ -90,7 +90,7 @@ pub fn pareto_front(rows: &[SpeedAccuracyRow]) -> Vec<usize> {
 
 /// (speed, error) of a row that can sit on log axes.
 fn plottable(r: &SpeedAccuracyRow) -> Option<(f64, f64)> {
-    let s = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0)?;
+    let s = r.sim_s_per_cpu_s.filter(|s| s.is_finite() && *s > 0.0)?;
     let e = r.force_rmse_n.filter(|e| e.is_finite() && *e > 0.0)?;
     (r.status == "ok").then_some((s, e))
 }
@@ -116,7 +116,7 @@ impl SpeedAccuracy {
             .iter()
             .filter(|r| r.status == "ok")
             .filter_map(|r| {
-                let s = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0)?;
+                let s = r.sim_s_per_cpu_s.filter(|s| s.is_finite() && *s > 0.0)?;
                 let e = r.drop_time_error_s.filter(|e| e.is_finite())?;
                 Some((r, s, e.abs()))
             })
@@ -146,7 +146,7 @@ impl SpeedAccuracy {
             .build_cartesian_2d(x.log_scale(), (y_lo..y_hi).log_scale())?;
         chart
             .configure_mesh()
-            .x_desc("speed [simulated s per wall-clock s] (log)")
+            .x_desc("speed [simulated s per CPU s, one core] (log)")
             .y_desc("|drop-time error| [s] (log)")
             .axis_desc_style((FONT, style::AXIS))
             .label_style((FONT, style::LABEL))
@@ -180,7 +180,7 @@ impl Chart for SpeedAccuracy {
     {
         let ok: Vec<(&SpeedAccuracyRow, f64, f64)> =
             self.rows.iter().filter_map(|r| plottable(r).map(|(s, e)| (r, s, e))).collect();
-        let speeds = self.rows.iter().filter_map(|r| r.sim_s_per_wall_s).filter(|s| s.is_finite() && *s > 0.0);
+        let speeds = self.rows.iter().filter_map(|r| r.sim_s_per_cpu_s).filter(|s| s.is_finite() && *s > 0.0);
         let (s_lo, s_hi) = speeds.fold((f64::INFINITY, 0.0f64), |(a, b), s| (a.min(s), b.max(s)));
         let (s_lo, s_hi) = if s_lo.is_finite() { (s_lo, s_hi) } else { (0.1, 10.0) };
         let (e_lo, e_hi) = ok.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.2), b.max(p.2)));
@@ -207,7 +207,7 @@ impl Chart for SpeedAccuracy {
             .build_cartesian_2d(((s_lo / 2.0)..(s_hi * 2.0)).log_scale(), (y_lo..y_hi).log_scale())?;
         chart
             .configure_mesh()
-            .x_desc("speed [simulated s per wall-clock s] (log)")
+            .x_desc("speed [simulated s per CPU s, one core] (log)")
             .y_desc("sensor-force RMSE against the reference [N] (log)")
             .axis_desc_style((FONT, style::AXIS))
             .label_style((FONT, style::LABEL))
@@ -249,7 +249,7 @@ impl Chart for SpeedAccuracy {
             .rows
             .iter()
             .filter(|r| r.status != "ok")
-            .filter_map(|r| r.sim_s_per_wall_s)
+            .filter_map(|r| r.sim_s_per_cpu_s)
             .filter(|s| s.is_finite() && *s > 0.0)
             .collect();
         if !failed.is_empty() {
@@ -275,7 +275,7 @@ impl Chart for SpeedAccuracy {
             }
         }
         for r in self.rows.iter().filter(|r| r.is_reference) {
-            let Some(s) = r.sim_s_per_wall_s.filter(|s| s.is_finite() && *s > 0.0) else { continue };
+            let Some(s) = r.sim_s_per_cpu_s.filter(|s| s.is_finite() && *s > 0.0) else { continue };
             // The reference has zero error against itself; it sits on the bottom edge then.
             let e = plottable(r).map_or(y_lo * 1.4, |p| p.1);
             chart.plotting_area().draw(&TriangleMarker::new((s, e), 10, BLACK.filled()))?;

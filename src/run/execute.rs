@@ -41,7 +41,7 @@ pub fn run_on_twin(
     models: &ModelCache,
     out: Option<&Path>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
-    let started = std::time::Instant::now();
+    let started = super::clock::RunClock::start();
     // Warnings left on this thread by an earlier run are not this run's.
     let _ = crate::mujoco_log::take_warnings();
     let mut cell = SimCell::for_scenario(scenario, models.get(&scenario.scene_spec())?);
@@ -62,13 +62,13 @@ pub fn run_on_twin(
 }
 
 /// Runs `scenario` on any cell, writing `trace.csv` and `summary.json` into `out` when given;
-/// the summary names the cell's backend. `started` is when the run's set-up began (its wall time
-/// counts from there).
+/// the summary names the cell's backend. `started` is when the run's set-up began (its wall and CPU
+/// time count from there).
 pub fn run_on_cell(
     cell: &mut dyn Cell,
     scenario: &PickPlaceScenario,
     out: Option<&Path>,
-    started: std::time::Instant,
+    started: super::clock::RunClock,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     let mut trace = match out {
         Some(dir) => {
@@ -82,7 +82,7 @@ pub fn run_on_cell(
         None => None,
     };
     let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
-    let mut summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.elapsed().as_secs_f64());
+    let mut summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.wall_s(), started.thread_cpu_s());
     // The run's own thread stepped its physics (and compiled its model, if not cached).
     summary.warnings = crate::mujoco_log::take_warnings();
     if let Some(dir) = out {

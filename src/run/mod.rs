@@ -1,5 +1,6 @@
 //! Running the pick-and-place task on a cell and recording it.
 //!
+//! - [`clock`]: a run's wall and CPU time.
 //! - [`drop_watch`]: when a simulated object counts as dropped.
 //! - [`execute`]: one scenario on the twin, files written.
 //! - [`runner`]: the control loop over any [`crate::hardware::Cell`].
@@ -9,6 +10,7 @@
 //! - [`metrics`]: rise time, overshoot, fluctuation, estimate error.
 //! - [`summary`]: the `summary.json` record.
 
+pub mod clock;
 pub mod drop_watch;
 pub mod execute;
 pub mod metrics;

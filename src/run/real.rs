@@ -18,7 +18,7 @@ pub fn run_on_real(
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     // Disturbances are the twin's: refuse before any device is contacted.
     scenario.disturbance.refuse_on_real().map_err(|e| anyhow::anyhow!("{e}"))?;
-    let started = std::time::Instant::now();
+    let started = super::clock::RunClock::start();
     let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator);
     let mut cell = LimitedCell::new(RealCell::new(config), limits);
     run_on_cell(&mut cell, scenario, out, started)

@@ -66,6 +66,14 @@ pub struct RunSummary {
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub real_time_factor: f64,
+    /// CPU time of the thread that ran the task \[s\]: on the twin, the physics and the control
+    /// code, unaffected by what else the machine runs (on the real cell, the control loop only).
+    #[serde(default)]
+    pub cpu_time_s: f64,
+    /// Simulated seconds per CPU second of that thread: the speed the benchmarks and speed charts
+    /// compare, since it does not change with the machine's load.
+    #[serde(default)]
+    pub sim_s_per_cpu_s: f64,
     /// The error that ended the run, with its time.
     pub error: Option<String>,
     /// Sensor samples that gave no force estimate (non-finite, or below the calibration curve) and
@@ -100,8 +108,8 @@ impl RunSummary {
         crate::sweep::results::flatten_summary(&RunSummary::default()).into_iter().map(|(k, _)| k).collect()
     }
 
-    /// Builds the summary from a run's identity, report and wall time.
-    pub fn new(id: RunIdentity, report: &RunReport, wall_time_s: f64) -> RunSummary {
+    /// Builds the summary from a run's identity, report, wall time and CPU time.
+    pub fn new(id: RunIdentity, report: &RunReport, wall_time_s: f64, cpu_time_s: f64) -> RunSummary {
         let since_motion = |t: f64| report.motion_start_s.map(|m| t - m);
         RunSummary {
             run: id,
@@ -119,6 +127,8 @@ impl RunSummary {
             sim_time_s: report.cell_time_s,
             wall_time_s,
             real_time_factor: if wall_time_s > 0.0 { report.cell_time_s / wall_time_s } else { f64::INFINITY },
+            cpu_time_s,
+            sim_s_per_cpu_s: if cpu_time_s > 0.0 { report.cell_time_s / cpu_time_s } else { f64::INFINITY },
             error: report.error.clone(),
             invalid_samples: report.invalid_samples,
             dropped_samples: report.dropped_samples,
@@ -163,8 +173,8 @@ pub fn render_text(s: &RunSummary) -> String {
     out += &format!("  max fluctuation    {}\n", opt(s.metrics.max_fluctuation_pct, "%"));
     out += &format!("  estimate RMSE      {}\n", opt(s.metrics.force_rmse_n, "N"));
     out += &format!(
-        "  simulated {:.1} s in {:.2} s wall: {:.0}x real time\n",
-        s.sim_time_s, s.wall_time_s, s.real_time_factor
+        "  simulated {:.1} s in {:.2} s wall ({:.0}x real time), {:.2} s of CPU ({:.0}x)\n",
+        s.sim_time_s, s.wall_time_s, s.real_time_factor, s.cpu_time_s, s.sim_s_per_cpu_s
     );
     out
 }

@@ -307,6 +307,12 @@ pub struct FingerConfig {
     /// 12.5 mm-radius handle, the coarsest finger whose answers agree with 64 links on outcome, rise
     /// and fluctuation (README, "Convergence"; 16 links moved the drops by 1.4-2.7 s).
     pub segments: u32,
+    /// How many times finer than `segments` implies the links are between the strip's base and the
+    /// pad's casing (1: a uniform grid). A numerical choice, like `segments`: that stretch holds the
+    /// pinch between palm and strip where the wrap starts, which carries most of an object held
+    /// without feedback and converges only at first order in the link length there (models/README.md,
+    /// "What still moves with the links"); doubling `segments` halves both grids.
+    pub base_refinement: u32,
     /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
     /// Strip thickness \[m\] (capsule diameter). 2 mm: a choice for a TPU strip with a tendon channel.
@@ -413,6 +419,7 @@ impl Default for FingerConfig {
     fn default() -> Self {
         FingerConfig {
             segments: 32,
+            base_refinement: 1,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,
@@ -451,6 +458,10 @@ impl Validate for FingerConfig {
         // finer than the strip's 2 mm thickness, so nothing finer describes the strip any better).
         at.require("segments", (2..=128).contains(&self.segments), || {
             format!("must be between 2 and 128, got {}", self.segments)
+        });
+        // 8: the base stretch's links are then 0.55 mm at 32 links, a quarter of the strip's thickness.
+        at.require("base_refinement", (1..=8).contains(&self.base_refinement), || {
+            format!("must be between 1 and 8, got {}", self.base_refinement)
         });
         at.in_range("length_m", self.length_m, 0.02, 0.5);
         at.in_range("thickness_m", self.thickness_m, 2e-4, 0.02);

@@ -43,9 +43,15 @@ pub fn layout(f: &FingerConfig) -> Vec<Piece> {
     let tip = length - TIP_LENGTH_M.min(length / 4.0);
     let edges = [pad.0, pad.1, tip];
     let inside_fixed = |s: f64| (s > pad.0 && s < pad.1) || s > tip;
-    let mut cuts: Vec<f64> = (1..f.segments)
-        .map(|i| f64::from(i) * l)
-        .filter(|&s| !inside_fixed(s) && edges.iter().all(|e| (s - e).abs() >= l / 2.0 - 1e-12))
+    // The base stretch (up to the pad's casing) on its finer grid, the rest on the uniform one; a
+    // grid point closer than half its own link to a fixed edge is dropped.
+    let base_l = l / f64::from(f.base_refinement.max(1));
+    let base_grid = (1..).map(|i| f64::from(i) * base_l).take_while(|&s| s < pad.0).map(|s| (s, base_l));
+    let rest_grid = (1..f.segments).map(|i| (f64::from(i) * l, l)).filter(|&(s, _)| s > pad.0);
+    let mut cuts: Vec<f64> = base_grid
+        .chain(rest_grid)
+        .filter(|&(s, h)| !inside_fixed(s) && edges.iter().all(|e| (s - e).abs() >= h / 2.0 - 1e-12))
+        .map(|(s, _)| s)
         .collect();
     cuts.extend(edges);
     cuts.push(0.0);
