@@ -87,19 +87,21 @@ impl ContactDetector {
     }
 }
 
+/// A deterministic N(0, σ²) stream (Box-Muller on a small LCG), so the detectors' tests need no RNG
+/// crate.
+#[cfg(test)]
+pub(crate) fn gaussian(sigma: f64, n: usize, seed: u64) -> Vec<f64> {
+    let mut s = seed;
+    let mut uniform = move || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    (0..n).map(|_| sigma * (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos()).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A deterministic N(0, σ²) stream (Box-Muller on a small LCG), so the tests need no RNG crate.
-    fn gaussian(sigma: f64, n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
-        let mut uniform = move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        };
-        (0..n).map(|_| sigma * (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos()).collect()
-    }
 
     fn learnt(sigma: f64) -> ContactDetector {
         let mut d = ContactDetector::new(0.1);

@@ -279,6 +279,12 @@ impl TaskSequencer {
         self.unloaded_n = force_n;
     }
 
+    /// The SD of the estimates at home, nothing on the sensor \[N\] (0 before two of them): the
+    /// reading's noise, which the contact and slip detectors average against.
+    pub fn reading_noise_n(&self) -> f64 {
+        self.contact.noise_n()
+    }
+
     /// The current phase.
     pub fn phase(&self) -> Phase {
         self.phase

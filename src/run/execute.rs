@@ -82,7 +82,8 @@ pub fn run_on_cell(
         None => None,
     };
     let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
-    let mut summary = RunSummary::new(scenario.identity(cell.backend()), &report, started.wall_s(), started.thread_cpu_s());
+    let mut summary =
+        RunSummary::new(scenario.identity(cell.backend()), &report, started.wall_s(), started.thread_cpu_s());
     // The run's own thread stepped its physics (and compiled its model, if not cached).
     summary.warnings = crate::mujoco_log::take_warnings();
     if let Some(dir) = out {

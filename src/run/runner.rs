@@ -8,7 +8,7 @@ use super::trace::{TraceRow, TraceWriter};
 use crate::control::controller::{ControllerConfig, ForceController};
 use crate::control::estimate::{Estimate, EstimateError, ForceCalibration, ForceEstimator};
 use crate::control::gripper::GripperConfig;
-use crate::control::slip::{SlipConfig, SlipDetector, SlipEvents};
+use crate::control::slip::{Alarms, Judgement, SlipConfig, SlipDetector, SlipEvents, judge};
 use crate::control::task::{Phase, TaskConfig, TaskSequencer};
 use crate::hardware::{Cell, CellError};
 use crate::signals::Wavelengths;
@@ -67,6 +67,10 @@ pub struct RunReport {
     pub motion_start_s: Option<f64>,
     /// What the sensor-based slip detector saw.
     pub slip: SlipEvents,
+    /// The detector's alarm episodes.
+    pub alarms: Alarms,
+    /// The drop alarms judged against the true drop (`None` on a cell without ground truth).
+    pub detection: Option<Judgement>,
     /// Rise time, overshoot, fluctuation, estimate error.
     pub metrics: ControlMetrics,
     /// Cell time reached \[s\].
@@ -179,7 +183,14 @@ pub fn run_task_observed(
                 last_phase = Some(decision.phase);
             }
             // Slip is watched while the arm carries the object, as in the paper.
-            slip.update(state.time_s, estimate.force_n, unloaded_n, plan.setpoint_n, decision.phase.arm_moving());
+            slip.update(
+                state.time_s,
+                estimate.force_n,
+                unloaded_n,
+                sequencer.reading_noise_n(),
+                plan.setpoint_n,
+                decision.phase.arm_moving(),
+            );
             cell.write(&decision.command)?;
 
             let truth = cell.ground_truth();
@@ -239,6 +250,8 @@ pub fn run_task_observed(
         drop,
         motion_start_s: sequencer.motion_start_s(),
         slip: slip.events(),
+        detection: has_truth.then(|| judge(&slip.alarms().drops_s, truth_drop.map(|d| d.cell_time_s))),
+        alarms: slip.alarms().clone(),
         metrics,
         cell_time_s: rows.last().map_or(0.0, |r| r.time_s),
         error,

@@ -57,6 +57,23 @@ pub struct RunSummary {
     pub drop_phase: Option<String>,
     /// When the sensor-based detector saw slip start, after the arm started moving \[s\].
     pub slip_detected_s: Option<f64>,
+    /// When the sensor-based detector raised its first drop alarm (a sudden fall, or the loss),
+    /// after the arm started moving \[s\].
+    #[serde(default)]
+    pub drop_alarm_s: Option<f64>,
+    /// Slip-warning episodes (the estimate below half the setpoint; [`crate::control::slip`]).
+    #[serde(default)]
+    pub slip_warnings: u64,
+    /// Drop-alarm episodes.
+    #[serde(default)]
+    pub drop_alarms: u64,
+    /// On the twin: from the true drop to the first drop alarm at most 0.5 s before it \[s\]
+    /// (negative: the alarm came first; absent: no drop, or the sensor did not see it).
+    #[serde(default)]
+    pub drop_detection_delay_s: Option<f64>,
+    /// On the twin: drop alarms that no drop followed (absent on the real cell, which cannot tell).
+    #[serde(default)]
+    pub false_alarms: Option<u64>,
     /// Rise time, overshoot, fluctuation, estimate error, oscillation.
     #[serde(flatten)]
     pub metrics: ControlMetrics,
@@ -123,6 +140,11 @@ impl RunSummary {
             drop_cell_time_s: report.drop.map(|d| d.cell_time_s),
             drop_phase: report.drop.map(|d| d.phase.name().to_string()),
             slip_detected_s: report.slip.slip_start_s.and_then(since_motion),
+            drop_alarm_s: report.slip.drop_alarm_s.and_then(since_motion),
+            slip_warnings: report.alarms.warnings_s.len() as u64,
+            drop_alarms: report.alarms.drops_s.len() as u64,
+            drop_detection_delay_s: report.detection.and_then(|j| j.detection_delay_s),
+            false_alarms: report.detection.map(|j| j.false_alarms),
             metrics: report.metrics,
             sim_time_s: report.cell_time_s,
             wall_time_s,
@@ -162,6 +184,16 @@ pub fn render_text(s: &RunSummary) -> String {
     if let Some(e) = &s.error {
         out += &format!("  error              {e}\n");
     }
+    out += &format!("  slip detector      {} warning(s), {} drop alarm(s)", s.slip_warnings, s.drop_alarms);
+    if let Some(d) = s.drop_detection_delay_s {
+        out += &format!("; saw the drop {:.2} s {}", d.abs(), if d < 0.0 { "before it" } else { "after it" });
+    } else if s.drop_time_s.is_some() && s.false_alarms.is_some() {
+        out += "; did not see the drop";
+    }
+    if let Some(n) = s.false_alarms.filter(|&n| n > 0) {
+        out += &format!("; {n} false");
+    }
+    out += "\n";
     if s.dropped_samples > 0 {
         out += &format!("  dropped samples    {} ticks without a new sample (estimate held)\n", s.dropped_samples);
     }

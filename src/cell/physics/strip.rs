@@ -95,4 +95,28 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn a_refined_base_cuts_only_the_stretch_before_the_pad_finer() {
+        let uniform = layout(&FingerConfig::default());
+        let f = FingerConfig { base_refinement: 4, ..FingerConfig::default() };
+        let refined = layout(&f);
+        let pad_start = f.pad_position_m - PAD_HALF_LENGTH_M;
+        let (l, h) = (f.segment_length_m(), f.segment_length_m() / 4.0);
+        // The pieces from the pad on (the pad's own joint span counts half its finer neighbour).
+        let after_pad = |p: &[Piece]| {
+            p.iter()
+                .filter(|x| x.start_m >= pad_start - 1e-12)
+                .map(|x| (x.start_m, x.length_m, x.fixed))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(after_pad(&refined), after_pad(&uniform), "the pad and the strip beyond it are unchanged");
+        let base: Vec<&Piece> = refined.iter().filter(|p| p.start_m < pad_start - 1e-12).collect();
+        assert!(base.len() >= 4 * (pad_start / l).floor() as usize, "{} links before the pad", base.len());
+        for p in &base {
+            assert!(!p.fixed && p.length_m >= h / 2.0 - 1e-12 && p.length_m < 1.5 * h + 1e-12, "{p:?}");
+        }
+        let total: f64 = refined.iter().map(|p| p.length_m).sum();
+        assert!((total - f.length_m).abs() < 1e-12);
+    }
 }
