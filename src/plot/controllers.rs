@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The columns of `controllers.csv`, in order.
-pub const COLUMNS: [&str; 12] = [
+pub const COLUMNS: [&str; 14] = [
     "controller",
     "object",
     "disturbance",
@@ -24,6 +24,8 @@ pub const COLUMNS: [&str; 12] = [
     "overshoot_pct",
     "max_fluctuation_pct",
     "peak_force_n",
+    "drop_detection_delay_s",
+    "false_alarms",
     "error",
 ];
 
@@ -52,11 +54,15 @@ pub struct ControllerRow {
     pub fluctuation_pct: Option<f64>,
     /// Largest (despiked) estimate while holding \[N\].
     pub peak_force_n: Option<f64>,
+    /// From the true drop to the slip detector's drop alarm \[s\] (None: no drop, or not seen).
+    pub drop_detection_delay_s: Option<f64>,
+    /// The slip detector's drop alarms that no drop followed.
+    pub false_alarms: Option<u64>,
     /// The error that ended the run, if any.
     pub error: Option<String>,
 }
 
-/// Reads `controllers.csv` (the [`COLUMNS`]; `error` may be absent).
+/// Reads `controllers.csv` (the [`COLUMNS`]; `error` and the detector's columns may be absent).
 pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
     let t = Table::read(path)?;
     let col = |name: &str| t.column(name);
@@ -66,6 +72,7 @@ pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
     let (rise, overshoot, fluctuation, peak) =
         (col("rise_time_s")?, col("overshoot_pct")?, col("max_fluctuation_pct")?, col("peak_force_n")?);
     let error = t.optional_column("error");
+    let (delay, false_alarms) = (t.optional_column("drop_detection_delay_s"), t.optional_column("false_alarms"));
     let rows = t
         .iter()
         .map(|r| {
@@ -86,6 +93,14 @@ pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
                 overshoot_pct: r.opt_f64(overshoot)?,
                 fluctuation_pct: r.opt_f64(fluctuation)?,
                 peak_force_n: r.opt_f64(peak)?,
+                drop_detection_delay_s: match delay {
+                    Some(c) => r.opt_f64(c)?,
+                    None => None,
+                },
+                false_alarms: match false_alarms {
+                    Some(c) => r.opt_f64(c)?.map(|n| n as u64),
+                    None => None,
+                },
                 error: error.map(|c| r.text(c)).filter(|e| !e.is_empty()).map(str::to_string),
             })
         })

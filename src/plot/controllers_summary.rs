@@ -7,6 +7,10 @@ use super::grid::first_seen;
 /// The issue's bound on the largest fluctuation while the arm moves \[%\].
 pub const GOAL_FLUCTUATION_PCT: f64 = 10.0;
 
+/// How soon after the true drop the slip detector must raise its drop alarm for the drop to count
+/// as seen \[s\] (the issue's 0.3 s).
+pub const SEEN_WITHIN_S: f64 = 0.3;
+
 /// One (controller, object, disturbance set) over its seeds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SummaryRow {
@@ -40,6 +44,12 @@ pub struct SummaryRow {
     pub peak_force_mean_n: Option<f64>,
     /// Largest peak force \[N\].
     pub peak_force_worst_n: Option<f64>,
+    /// Runs whose outcome is "dropped".
+    pub drops: usize,
+    /// Dropped runs whose drop the slip detector saw within [`SEEN_WITHIN_S`].
+    pub drops_seen: usize,
+    /// The slip detector's drop alarms that no drop followed, over the runs.
+    pub false_alarms: u64,
 }
 
 /// Mean and largest of `values` (None for both when empty).
@@ -71,7 +81,14 @@ pub fn aggregate(rows: &[ControllerRow]) -> Vec<SummaryRow> {
             let (rise_mean_s, rise_worst_s) = mean_max(&rise);
             let (overshoot_mean_pct, overshoot_worst_pct) = mean_max(&overshoot);
             let (peak_force_mean_n, peak_force_worst_n) = mean_max(&peak);
+            let dropped: Vec<&&ControllerRow> = group.iter().filter(|r| r.outcome == "dropped").collect();
             SummaryRow {
+                drops: dropped.len(),
+                drops_seen: dropped
+                    .iter()
+                    .filter(|r| r.drop_detection_delay_s.is_some_and(|d| d <= SEEN_WITHIN_S))
+                    .count(),
+                false_alarms: group.iter().filter_map(|r| r.false_alarms).sum(),
                 controller: controller.clone(),
                 object: object.clone(),
                 disturbance: disturbance.clone(),
@@ -117,12 +134,12 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 pub fn markdown(rows: &[SummaryRow]) -> String {
     let mut s = String::from(
         "| object | disturbance | controller | held | fluctuation while moving, mean / worst [%] | rise, mean [s] | \
-         overshoot, mean / worst [%] | peak force, mean / worst [N] |\n\
-         | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+         overshoot, mean / worst [%] | peak force, mean / worst [N] | drops seen ≤ 0.3 s | false alarms |\n\
+         | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {} | {} | {}/{} | {} / {} | {} | {} / {} | {} / {} |\n",
+            "| {} | {} | {} | {}/{} | {} / {} | {} | {} / {} | {} / {} | {} | {} |\n",
             r.object,
             r.disturbance,
             r.controller,
@@ -135,6 +152,8 @@ pub fn markdown(rows: &[SummaryRow]) -> String {
             fmt(r.overshoot_worst_pct, 0),
             fmt(r.peak_force_mean_n, 2),
             fmt(r.peak_force_worst_n, 2),
+            if r.drops == 0 { "-".to_string() } else { format!("{}/{}", r.drops_seen, r.drops) },
+            r.false_alarms,
         );
     }
     s
@@ -157,6 +176,9 @@ mod tests {
             overshoot_pct: Some(10.0 * peak),
             fluctuation_pct: fluctuation,
             peak_force_n: Some(peak),
+            // A drop seen 0.1 s after it; a held run with one false alarm.
+            drop_detection_delay_s: (outcome == "dropped").then_some(0.1),
+            false_alarms: Some(u64::from(outcome == "held")),
             error: None,
         }
     }
@@ -181,6 +203,7 @@ mod tests {
         assert_eq!(pid.peak_force_worst_n, Some(3.0));
         assert_eq!(pid.peak_force_mean_n, Some(6.5 / 4.0));
         assert_eq!(pid.overshoot_worst_pct, Some(30.0));
+        assert_eq!((pid.drops, pid.drops_seen, pid.false_alarms), (1, 1, 2));
         assert!(!meets_goal(pid));
         assert!(meets_goal(&s[1]));
     }

@@ -162,6 +162,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                 overshoot_pct: started.then_some(s.metrics.overshoot_pct),
                 fluctuation_pct: s.metrics.max_fluctuation_pct,
                 peak_force_n: s.metrics.peak_force_n,
+                drop_detection_delay_s: s.drop_detection_delay_s,
+                false_alarms: s.false_alarms,
                 error: s.error,
             });
         }
@@ -191,12 +193,14 @@ fn run_cells(r: &ControllerRow) -> Vec<String> {
         cell(r.overshoot_pct),
         cell(r.fluctuation_pct),
         cell(r.peak_force_n),
+        cell(r.drop_detection_delay_s),
+        r.false_alarms.map_or(String::new(), |n| n.to_string()),
         r.error.clone().unwrap_or_default(),
     ]
 }
 
 /// The columns of `controllers_summary.csv`.
-pub const SUMMARY_COLUMNS: [&str; 15] = [
+pub const SUMMARY_COLUMNS: [&str; 18] = [
     "controller",
     "object",
     "disturbance",
@@ -212,6 +216,9 @@ pub const SUMMARY_COLUMNS: [&str; 15] = [
     "overshoot_worst_pct",
     "peak_force_mean_n",
     "peak_force_worst_n",
+    "drops",
+    "drops_seen",
+    "false_alarms",
 ];
 
 /// The cells of one summary row, in [`SUMMARY_COLUMNS`] order.
@@ -232,5 +239,8 @@ fn summary_cells(r: &SummaryRow) -> Vec<String> {
         cell(r.overshoot_worst_pct),
         cell(r.peak_force_mean_n),
         cell(r.peak_force_worst_n),
+        r.drops.to_string(),
+        r.drops_seen.to_string(),
+        r.false_alarms.to_string(),
     ]
 }
