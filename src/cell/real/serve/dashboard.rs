@@ -142,6 +142,8 @@ pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bo
         Command::Pause => reply::PAUSE_FAILED.into(),
         Command::Load(file) if file.ends_with(".urp") => {
             s.ur.loaded_program = Some(file.clone());
+            // The one program a `.urp` stands for: the follow program.
+            s.program_source = None;
             s.program = ProgramState::Stopped;
             loading(file)
         }

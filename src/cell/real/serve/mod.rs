@@ -22,8 +22,10 @@
 //! Nothing here panics on input.
 
 pub mod dashboard;
+pub mod io;
 mod net;
 pub mod pose;
+pub mod program;
 pub mod safety;
 mod twin;
 

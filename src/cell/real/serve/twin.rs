@@ -5,19 +5,19 @@ use super::pose::tcp_pose;
 use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
-use crate::cell::real::protocol::dashboard::RobotMode;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
 use crate::cell::real::protocol::dynamixel::units::{
     baud_rate_code, present_current_units, present_velocity_units, rad_to_ticks, ticks_to_rad,
 };
 use crate::cell::real::protocol::dynamixel::{ControlTable, StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
+use super::program::{ArmCommand, ProgramRunner};
 use crate::cell::real::protocol::rtde::state::{
     RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
 };
 use crate::cell::real::protocol::rtde::{RobotOutputs, SharedInputs};
 use crate::cell::real::realtime::RealtimeOptions;
-use crate::cell::real::urscript::{ENABLE_REGISTER, FOLLOWING_REGISTER, RtdeWatchdog, TARGET_REGISTER, WatchdogAction};
+use crate::cell::real::urscript::RtdeWatchdog;
 use crate::cell::sim::SimCell;
 use crate::hardware::{ARM_JOINTS, Cell, CellCommand, GroundTruth};
 use crate::run::scenario::PickPlaceScenario;
@@ -74,13 +74,18 @@ pub struct DeviceState {
     pub outputs: RobotOutputs,
     /// What RTDE clients wrote.
     pub inputs: SharedInputs,
-    /// The program that came in on the secondary interface: it plays from its upload until its
-    /// RTDE watchdog or a protective stop stops it.
+    /// The program's state: it plays from its upload until it ends, fails, or its RTDE watchdog,
+    /// a protective stop or the dashboard stops it ([`super::program`]).
     pub program: ProgramState,
-    /// The program's `rtde_set_watchdog` call, if it has one.
+    /// The text of the last program uploaded (`None`: the follow program, as `load X.urp` gives).
+    pub program_source: Option<String>,
+    /// The watchdog the running program set with `rtde_set_watchdog`, if any.
     pub watchdog: Option<RtdeWatchdog>,
     /// Programs uploaded so far (each upload restarts the program and its watchdog).
     pub program_uploads: u64,
+    /// The program's `textmsg`/`popup` lines and runtime errors, the latest
+    /// [`super::program::LOG_LINES`].
+    pub program_log: std::collections::VecDeque<String>,
     /// Why the arm is in a protective stop, if it is (cleared by `unlock protective stop` on the
     /// dashboard, or by a fresh program upload).
     pub protective_stop: Option<String>,
@@ -125,8 +130,10 @@ pub fn shared_state(
         outputs: RobotOutputs::default(),
         inputs: SharedInputs::new(),
         program: ProgramState::Stopped,
+        program_source: None,
         watchdog: None,
         program_uploads: 0,
+        program_log: std::collections::VecDeque::new(),
         protective_stop: None,
         ur: UrController::new(ur),
         bus,
@@ -229,10 +236,8 @@ pub fn spawn(
         // The motors' speeds, the same way (Present Velocity).
         let mut motor_rad_s = [0.0; 2];
         let mut measured_q = first.arm_q;
-        // The program's RTDE watchdog once armed: the watched input's write count and when it last
-        // changed (twin time, so a twin held up by a lock never counts as a silent client).
-        let mut watchdog: Option<(u64, f64)> = None;
-        let mut uploads_seen = 0;
+        // The virtual controller's program (the URScript interpreter).
+        let mut program = ProgramRunner::default();
         {
             let mut s = lock(&state);
             for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
@@ -247,7 +252,6 @@ pub fn spawn(
             s.outputs.actual_tcp_pose = tcp_pose(&first.arm_q, &s.outputs.tcp_offset);
             s.outputs.target_tcp_pose = s.outputs.actual_tcp_pose;
         }
-        let mut packages_seen = 0;
         let started = Instant::now();
         for k in 1u64.. {
             if stop.load(Ordering::SeqCst) {
@@ -256,67 +260,21 @@ pub fn spawn(
             let now_s = (k - 1) as f64 * period_s;
             let new_arm_target = {
                 let mut s = lock(&state);
-                if s.program_uploads != uploads_seen {
-                    uploads_seen = s.program_uploads;
-                    watchdog = None;
+                // RTDEIOInterface and the like: the IO outputs each input package set.
+                for package in s.inputs.take_io_packages() {
+                    super::io::apply_io_package(&package, &mut s.outputs);
                 }
-                let enabled = s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
-                let targets: [f64; ARM_JOINTS] =
-                    std::array::from_fn(|j| s.inputs.values.double_registers[TARGET_REGISTER + j]);
-                // A target is new when a package came in: the arm then moves to it over the time
-                // since the one before, the client's cadence, as the simulated path's arm does.
-                let arrived = s.inputs.packages != packages_seen;
-                packages_seen = s.inputs.packages;
-                let mut hold = false;
-                // rtde_set_watchdog, as our program calls it: armed at the first enabled tick.
-                let watched =
-                    s.watchdog.as_ref().map(|w| (s.inputs.writes_of(&w.variable), w.min_frequency_hz, w.action));
-                if s.program == ProgramState::Playing
-                    && let Some((writes, min_hz, action)) = watched
-                {
-                    match &mut watchdog {
-                        None if enabled => watchdog = Some((writes, now_s)),
-                        None => {}
-                        Some((seen, at)) if *seen != writes => (*seen, *at) = (writes, now_s),
-                        Some((_, at)) if now_s - *at > 1.0 / min_hz => match action {
-                            WatchdogAction::Ignore => {}
-                            WatchdogAction::Pause | WatchdogAction::Stop => {
-                                s.program = if action == WatchdogAction::Stop {
-                                    ProgramState::Stopped
-                                } else {
-                                    ProgramState::Paused
-                                };
-                                hold = true;
-                            }
-                        },
-                        Some(_) => {}
+                let new = match program.tick(&mut s, now_s, measured_q) {
+                    ArmCommand::Keep => false,
+                    ArmCommand::Move(q) => {
+                        command.arm_q = q;
+                        true
                     }
-                }
-                // Powered off or brakes engaged (dashboard): no program runs, the arm holds.
-                if s.ur.robot_mode != RobotMode::Running && s.program != ProgramState::Stopped {
-                    s.program = ProgramState::Stopped;
-                    hold = true;
-                }
-                let mut new = false;
-                if s.program == ProgramState::Playing && enabled && arrived {
-                    match super::safety::violation(&targets, &measured_q) {
-                        None => {
-                            command.arm_q = targets;
-                            new = true;
-                        }
-                        Some(why) => {
-                            // Protective stop: the arm stops where it is, the program stops.
-                            s.protective_stop = Some(why);
-                            s.ur.protective_stop_at = Some(now_s);
-                            s.program = ProgramState::Stopped;
-                            hold = true;
-                        }
+                    ArmCommand::Hold => {
+                        command.arm_q = measured_q;
+                        true
                     }
-                }
-                if hold {
-                    command.arm_q = measured_q;
-                    new = true;
-                }
+                };
                 for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
                 {
                     if let Some(t) = s.bus.table(id)
@@ -348,8 +306,6 @@ pub fn spawn(
             measured_q = r.arm_q;
             {
                 let mut s = lock(&state);
-                let following =
-                    s.program == ProgramState::Playing && s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
                 let runtime_state = match s.program {
                     ProgramState::Stopped => RUNTIME_STATE_STOPPED,
                     ProgramState::Playing => RUNTIME_STATE_PLAYING,
@@ -368,7 +324,6 @@ pub fn spawn(
                 o.target_q = command.arm_q;
                 o.actual_tcp_pose = tcp_pose(&r.arm_q, &o.tcp_offset);
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
-                o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
                 for (m, id) in motors.into_iter().enumerate() {
                     if let Some(t) = s.bus.table_mut(id) {
                         present_motion(t, r.time_s, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
