@@ -162,6 +162,10 @@ pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bo
                 reply::PROTECTIVE_STOP_RELEASING.into()
             }
         },
+        // Ours: a UR serial number is digits (year, model, number); ur_rtde checks only that.
+        Command::GetSerialNumber if s.ur.has_remote_control() => "20215500001".into(),
+        Command::GetSerialNumber => not_understood("get serial number"),
+        Command::GetRobotModel => "UR5".into(),
         Command::Quit => return (reply::DISCONNECTED.into(), true),
         Command::Unknown(text) => not_understood(text),
     };

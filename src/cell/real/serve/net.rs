@@ -16,6 +16,9 @@ use tokio::sync::watch;
 
 /// Largest URScript program accepted [bytes].
 const MAX_PROGRAM_LEN: usize = 1 << 20;
+/// How long a script connection must stay quiet after a complete-looking program before the
+/// program is taken.
+const PROGRAM_SETTLE: Duration = Duration::from_millis(50);
 /// A client sending more than this without completing a frame is dropped [bytes].
 const MAX_PENDING: usize = 1 << 20;
 
@@ -140,15 +143,14 @@ async fn serve_script(mut socket: TcpStream, state: Shared) {
     let mut text = Vec::new();
     let mut chunk = [0u8; 4096];
     loop {
-        let read = tokio::time::timeout(Duration::from_secs(2), socket.read(&mut chunk)).await;
-        match read {
+        // A text that ends in `end` may still be a part: a large program (SDU ur_rtde's is 40 kB)
+        // arrives in pieces, any of which can end with a nested block's `end`. So the program is
+        // taken once the client has sent nothing more for a moment (or closed the connection).
+        let complete = std::str::from_utf8(&text).is_ok_and(is_complete_program);
+        let wait = if complete { PROGRAM_SETTLE } else { Duration::from_secs(2) };
+        match tokio::time::timeout(wait, socket.read(&mut chunk)).await {
             Ok(Ok(n)) if n > 0 && text.len() + n <= MAX_PROGRAM_LEN => text.extend_from_slice(&chunk[..n]),
             _ => break,
-        }
-        if let Ok(t) = std::str::from_utf8(&text)
-            && is_complete_program(t)
-        {
-            break;
         }
     }
     let Ok(program) = std::str::from_utf8(&text) else { return };

@@ -324,6 +324,17 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             cx.host.set_analog_out(n, f);
             Ok(V(Value::Void))
         }
+        // --- Force mode parameters: accepted (SDU ur_rtde's control script sets them at start);
+        // force mode itself is not supported. ---
+        "force_mode_set_gain_scaling" | "force_mode_set_damping" => {
+            a.check(&["v"])?;
+            let v = a.num(0, "v")?;
+            let max = if name == "force_mode_set_damping" { 1.0 } else { 2.0 };
+            if !(0.0..=max).contains(&v) {
+                return Err(format!("{name}: {v} is not in [0, {max}]"));
+            }
+            Ok(V(Value::Void))
+        }
         // --- Messages ---
         "textmsg" => {
             a.check(&["s1", "s2"])?;

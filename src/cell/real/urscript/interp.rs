@@ -372,7 +372,10 @@ impl Interpreter {
                 Op::Kill | Op::Join => {
                     let id = match pop(th, line)? {
                         Value::Thread(id) => id,
-                        other => return Err(err(format!("kill and join need a thread handle, got {}", other.describe()))),
+                        // `kill` of a handle variable still holding its initial 0 does nothing:
+                        // SDU ur_rtde's servo_stop kills `servoc_thrd`, 0 unless servoC ran.
+                        _ if matches!(op, Op::Kill) => continue,
+                        other => return Err(err(format!("join needs a thread handle, got {}", other.describe()))),
                     };
                     if matches!(op, Op::Join) {
                         if id == th.id {

@@ -41,6 +41,12 @@ struct Parser {
 
 const BLOCK_END: [&str; 3] = ["end", "elif", "else"];
 
+/// Names that cannot be variables.
+const KEYWORDS: [&str; 17] = [
+    "end", "elif", "else", "def", "thread", "if", "while", "return", "global", "local", "break", "continue",
+    "halt", "kill", "join", "and", "or",
+];
+
 impl Parser {
     fn peek(&self) -> Option<&Tok> {
         self.tokens.get(self.pos).map(|t| &t.tok)
@@ -98,15 +104,13 @@ impl Parser {
         }
     }
 
+    /// The end of a statement. URScript does not need a line end there: the controller takes
+    /// `global a = # comment` with the value on the next line, and two statements on one line,
+    /// which SDU ur_rtde's control script relies on (its register-offset injection leaves
+    /// `0    global reg_offset_int = ...`).
     fn expect_newline(&mut self) -> Result<(), ScriptError> {
-        match self.peek() {
-            Some(Tok::Newline) => {
-                self.skip_newlines();
-                Ok(())
-            }
-            None => Ok(()),
-            _ => Err(self.error("expected the end of the line")),
-        }
+        self.skip_newlines();
+        Ok(())
     }
 
     fn skip_newlines(&mut self) {
@@ -400,6 +404,11 @@ impl Parser {
     }
 
     fn primary(&mut self) -> Result<Expr, ScriptError> {
+        // An expression may continue on the next line (see `expect_newline`).
+        self.skip_newlines();
+        if matches!(self.peek(), Some(Tok::Name(n)) if KEYWORDS.contains(&n.as_str())) {
+            return Err(self.error("expected an expression"));
+        }
         let tok = self.peek().cloned();
         match tok {
             Some(Tok::Int(i)) => {
@@ -529,7 +538,10 @@ mod tests {
 
     #[test]
     fn calls_keywords_threads_indexing_and_p_as_a_variable() {
-        let b = body("  movej(q, a=1.4, v=1.05)\n  h = run t()\n  p[0] = p[0] * 2\n  global g = [1, 2]\n  thread t():\n    sync()\n  end");
+        let b = body("  x = # a comment, the value on the next line\n  0    y = 2\n  movej(q, a=1.4, v=1.05)\n  h = run t()\n  p[0] = p[0] * 2\n  global g = [1, 2]\n  thread t():\n    sync()\n  end");
+        assert!(matches!(&b[0].kind, StmtKind::Assign { name, value: Expr::Lit(Value::Int(0)), .. } if name == "x"));
+        assert!(matches!(&b[1].kind, StmtKind::Assign { name, .. } if name == "y"));
+        let b = &b[2..];
         assert!(matches!(&b[0].kind, StmtKind::Expr(Expr::Call { args, kwargs, .. }) if args.len() == 1 && kwargs.len() == 2));
         assert!(matches!(&b[1].kind, StmtKind::Assign { value: Expr::Run(t), .. } if t == "t"));
         assert!(matches!(&b[2].kind, StmtKind::Assign { name, indices, .. } if name == "p" && indices.len() == 1));
@@ -540,7 +552,7 @@ mod tests {
     #[test]
     fn errors_name_the_line_and_what_was_expected() {
         for (src, line, what) in [
-            ("def prog():\n  x = 1 +\nend\n", 2, "expected an expression"),
+            ("def prog():\n  x = 1 +\nend\n", 3, "expected an expression"),
             ("def prog():\n  if x\n  end\nend\n", 2, "expected `:`"),
             ("def prog():\n  x = 1\n", 2, "expected `end`"),
             ("x = 1\n", 1, "starts with"),

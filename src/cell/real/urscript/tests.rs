@@ -203,7 +203,7 @@ fn runtime_errors_name_the_line_and_the_reason() {
         ("  read_input_integer_register(48)", 2, "0..47"),
         ("  movej([0, 0, 0])", 2, "list of 6"),
         ("  def f():\n    return f()\n  end\n  f()", 3, "deeper"),
-        ("  kill 3", 2, "thread handle"),
+        ("  join 3", 2, "thread handle"),
         ("  rtde_set_watchdog(\"a\", 1, \"halt\")", 2, "action"),
     ] {
         let mut p = Interpreter::new(&program(body), [0.0; 6]).unwrap();
