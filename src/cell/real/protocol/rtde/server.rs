@@ -249,11 +249,9 @@ impl ServerSession {
         let recipe =
             self.inputs.get(usize::from(recipe_id).wrapping_sub(1)).ok_or(RtdeError::UnknownRecipe(recipe_id))?;
         let values = recipe.decode(data)?;
-        // The controller takes inputs only from a started session (RTDE guide: data packages
-        // are exchanged after RTDE_CONTROL_PACKAGE_START).
-        if !self.started {
-            return Ok(());
-        }
+        // Applied whether or not the session was started: SDU ur_rtde's RTDEIOInterface sets up
+        // its input recipes and sends data packages without ever sending START, and works on real
+        // controllers, so they take inputs from a session that has not started.
         let io: Vec<(String, RtdeValue)> = recipe
             .names
             .iter()
