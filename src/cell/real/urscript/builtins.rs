@@ -100,17 +100,23 @@ fn positive(name: &str, what: &str, v: f64) -> Result<f64, String> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{name}: `{what}` must be positive, got {v}")) }
 }
 
+fn duration(name: &str, t: f64) -> Result<f64, String> {
+    if t.is_finite() && t >= 0.0 { Ok(t) } else { Err(format!("{name}: `t` must be a non-negative time, got {t}")) }
+}
+
 fn finite6(name: &str, v: [f64; 6]) -> Result<[f64; 6], String> {
     if v.iter().all(|x| x.is_finite()) { Ok(v) } else { Err(format!("{name}: {v:?} is not finite")) }
 }
 
 /// Joint angles for a `movej`/`servoj` target given as joints or as a pose (a pose is solved
-/// near the current setpoint, as `get_inverse_kin` does).
+/// near the current setpoint, as `get_inverse_kin` does). Joint targets are not checked here:
+/// a non-finite or out-of-range one reaches the safety check and ends in a protective stop, as on
+/// the controller.
 fn joints_of(name: &str, v: &Value, near: &[f64; 6]) -> Result<[f64; 6], String> {
     match v {
         Value::Pose(p) => ur5e::inverse_near(&pose_from_vector(&finite6(name, *p)?), near)
             .ok_or_else(|| format!("{name}: no joint solution for {v}")),
-        other => finite6(name, other.six(&format!("{name}'s target"))?),
+        other => other.six(&format!("{name}'s target")),
     }
 }
 
@@ -151,7 +157,7 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             let target = joints_of(name, a.value(0, "q")?, &cx.arm.target_q())?;
             let acc = positive(name, "a", a.num_or(1, "a", 1.4)?)?;
             let vel = positive(name, "v", a.num_or(2, "v", 1.05)?)?;
-            let t = a.num_or(3, "t", 0.0)?;
+            let t = duration(name, a.num_or(3, "t", 0.0)?)?;
             Ok(Outcome::Move(Value::Void, cx.arm.movej(target, acc, vel, t, cx.thread)))
         }
         "movel" => {
@@ -162,7 +168,7 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             };
             let acc = positive(name, "a", a.num_or(1, "a", 1.2)?)?;
             let vel = positive(name, "v", a.num_or(2, "v", 0.25)?)?;
-            let t = a.num_or(3, "t", 0.0)?;
+            let t = duration(name, a.num_or(3, "t", 0.0)?)?;
             Ok(Outcome::Move(Value::Void, cx.arm.movel(target, acc, vel, t, cx.thread)?))
         }
         "servoj" => {

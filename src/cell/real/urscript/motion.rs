@@ -66,7 +66,7 @@ impl Profile {
 
     /// Fraction of the distance covered at time `t` after the start, in \[0, 1\].
     pub fn fraction(&self, t: f64) -> f64 {
-        if self.dist <= 0.0 || self.total <= 0.0 {
+        if self.dist <= 0.0 || self.total <= 0.0 || !self.total.is_finite() {
             return 1.0;
         }
         let t = (t / self.stretch).clamp(0.0, self.total);
@@ -162,6 +162,13 @@ impl Arm {
 
     /// `movej`: returns the motion's number (the caller waits until it is finished).
     pub fn movej(&mut self, to: [f64; 6], a: f64, v: f64, t: f64, owner: u64) -> u64 {
+        if to.iter().any(|x| !x.is_finite()) {
+            // Commanded as it is: the safety check turns it into a protective stop.
+            self.pending = Some(to);
+            let id = self.begin(Motion::Hold, owner);
+            self.done = true;
+            return id;
+        }
         let dist = (0..6).fold(0.0_f64, |m, j| m.max((to[j] - self.q[j]).abs()));
         let profile = Profile::new(dist, v.min(MAX_JOINT_SPEED_RAD_S), a, t);
         self.begin(Motion::Joint { from: self.q, to, profile, start: f64::NAN }, owner)
