@@ -30,8 +30,22 @@ pub const LOG_LINES: usize = 500;
 pub enum ArmCommand {
     /// Keep the last command.
     Keep,
-    /// Move to these joint angles \[rad\].
+    /// Move to these joint angles \[rad\] (a `servoj` target: commanded at once, the twin's arm
+    /// spreads the move over the time since the previous one, see [`crate::cell::real::urscript::motion`]).
     Move([f64; 6]),
+    /// Follow a generated trajectory: the setpoint `q` \[rad\] at twin time `at_s` \[s\] moving at
+    /// `qd` \[rad/s\]. The twin commands the setpoint extrapolated to the end of each physics step:
+    /// commanding every 2 ms cycle against 5 ms physics steps would move the arm by two cycles'
+    /// way in some steps and three in others (`actual_qd` alternating between 0.8 and 1.2 times
+    /// the speed).
+    Track {
+        /// Setpoint \[rad\].
+        q: [f64; 6],
+        /// Its speed \[rad/s\].
+        qd: [f64; 6],
+        /// Its time \[s\].
+        at_s: f64,
+    },
     /// Stop where the arm is (the program stopped or a protective stop).
     Hold,
 }
@@ -137,6 +151,7 @@ impl ProgramRunner {
         let Some(interpreter) = self.interpreter.as_mut() else { return ArmCommand::Keep };
         let mut host = Host { s, measured_q, watchdog_set: false };
         let command = interpreter.step(cycle_s, &mut host);
+        let (servoing, qd) = (interpreter.servoing(), interpreter.target_qd());
         let watchdog_set = host.watchdog_set;
         let status = interpreter.status().clone();
         if watchdog_set {
@@ -159,7 +174,8 @@ impl ProgramRunner {
         }
         let Some(q) = command else { return ArmCommand::Keep };
         match super::safety::violation(&q, &measured_q) {
-            None => ArmCommand::Move(q),
+            None if servoing => ArmCommand::Move(q),
+            None => ArmCommand::Track { q, qd, at_s: cycle_s },
             Some(why) => {
                 // Protective stop: the arm stops where it is, the program stops.
                 log(&mut s.program_log, &format!("protective stop: {why}"));

@@ -12,6 +12,7 @@ use crate::cell::real::protocol::dynamixel::units::{
 use crate::cell::real::protocol::dynamixel::{ControlTable, StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
 use super::program::{ArmCommand, ProgramRunner};
+use crate::cell::real::urscript::interp::CONTROL_PERIOD_S;
 use crate::cell::real::protocol::rtde::state::{
     RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
 };
@@ -238,6 +239,9 @@ pub fn spawn(
         let mut measured_q = first.arm_q;
         // The virtual controller's program (the URScript interpreter).
         let mut program = ProgramRunner::default();
+        // A generated trajectory's latest setpoint, its speed and time (see `ArmCommand::Track`).
+        let mut tracking: Option<([f64; 6], [f64; 6], f64)> = None;
+        let timestep_s = scenario.physics.timestep_s;
         {
             let mut s = lock(&state);
             for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
@@ -264,17 +268,37 @@ pub fn spawn(
                 for package in s.inputs.take_io_packages() {
                     super::io::apply_io_package(&package, &mut s.outputs);
                 }
-                let new = match program.tick(&mut s, now_s, measured_q) {
+                let mut new = match program.tick(&mut s, now_s, measured_q) {
                     ArmCommand::Keep => false,
+                    ArmCommand::Track { q, qd, at_s } => {
+                        tracking = Some((q, qd, at_s));
+                        false
+                    }
                     ArmCommand::Move(q) => {
+                        tracking = None;
                         command.arm_q = q;
                         true
                     }
                     ArmCommand::Hold => {
+                        tracking = None;
                         command.arm_q = measured_q;
                         true
                     }
                 };
+                // The physics steps in this tick's wait: command the trajectory's setpoint at the
+                // step's end (a step is due once the wait passes half of it, as `wait_until` runs).
+                let physics_s = last_step.0;
+                if let Some((q, qd, at_s)) = tracking
+                    && k as f64 * period_s - physics_s > 0.5 * timestep_s
+                {
+                    // Never more than a step and a cycle ahead of the program's last setpoint.
+                    let ahead = (physics_s + timestep_s - at_s).clamp(0.0, timestep_s + CONTROL_PERIOD_S);
+                    command.arm_q = std::array::from_fn(|j| q[j] + qd[j] * ahead);
+                    new = true;
+                    if qd.iter().all(|v| *v == 0.0) {
+                        tracking = None;
+                    }
+                }
                 for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
                 {
                     if let Some(t) = s.bus.table(id)

@@ -155,6 +155,11 @@ impl Interpreter {
         self.arm.target_qd()
     }
 
+    /// Whether the arm follows `servoj` targets rather than a generated trajectory.
+    pub fn servoing(&self) -> bool {
+        self.arm.servoing()
+    }
+
     /// A global variable's value (for tests and diagnostics).
     pub fn global(&self, name: &str) -> Option<&Value> {
         self.globals.get(name)

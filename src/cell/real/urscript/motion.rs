@@ -142,6 +142,12 @@ impl Arm {
         self.qd
     }
 
+    /// Whether the arm follows `servoj` targets (each commanded as it arrives) rather than a
+    /// generated trajectory.
+    pub fn servoing(&self) -> bool {
+        self.motion == Motion::Servo
+    }
+
     /// Whether motion `id` is over (finished, or replaced by another).
     pub fn finished(&self, id: u64) -> bool {
         id != self.id || self.done
@@ -235,7 +241,7 @@ impl Arm {
     /// Advances the setpoint to time `now` (cycle length `dt`) and returns the setpoint to command
     /// this cycle, if any.
     pub fn tick(&mut self, now: f64, dt: f64) -> Result<Option<[f64; 6]>, String> {
-        let before = self.q;
+        let (before, speed_before) = (self.q, self.qd);
         let mut moved = false;
         // Joint and linear moves: the speed is the setpoint's change over the cycle.
         let kinematic = matches!(self.motion, Motion::Joint { .. } | Motion::Linear { .. });
@@ -307,7 +313,9 @@ impl Arm {
         if let Some(q) = self.pending.take() {
             return Ok(Some(q));
         }
-        Ok(if moved && self.q != before { Some(self.q) } else { None })
+        // A new setpoint, or the same one with a new speed (the motion just came to rest: the
+        // twin extrapolates a moving setpoint, so it must learn that it stopped).
+        Ok(if (moved && self.q != before) || self.qd != speed_before { Some(self.q) } else { None })
     }
 }
 
