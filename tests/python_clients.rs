@@ -193,7 +193,8 @@ fn ur_rtde_control_interface_moves_the_twin_and_io_interface_sets_outputs() {
     assert!(running, "serve survived the client");
     assert_eq!(v["program_running"], true, "the uploaded control script plays");
     // moveJ there and back: the arm within 1 mrad of each target.
-    for ok in ["movej_ok", "movej_back_ok", "movel_ok", "servo_stop_ok", "speedj_ok", "speed_stop_ok", "movej_async_ok"] {
+    for ok in ["movej_ok", "movej_back_ok", "movel_ok", "servo_stop_ok", "speedj_ok", "speed_stop_ok", "movej_async_ok"]
+    {
         assert_eq!(v[ok], true, "{ok}: {v}");
     }
     close(&v["after_movej"], &v["q1"], 1e-3, "moveJ");

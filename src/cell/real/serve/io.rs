@@ -77,7 +77,8 @@ pub fn apply_io_package(package: &[(String, RtdeValue)], o: &mut RobotOutputs) {
             if mask >> i & 1 == 1 {
                 // The type field's bit i: output i in voltage mode.
                 let bit = 1u32 << (2 + i);
-                o.analog_io_types = if types >> i & 1 == 1 { o.analog_io_types | bit } else { o.analog_io_types & !bit };
+                o.analog_io_types =
+                    if types >> i & 1 == 1 { o.analog_io_types | bit } else { o.analog_io_types & !bit };
                 if let Some(f) = double(get(&format!("standard_analog_output_{i}"))) {
                     set_analog_out(o, i, f);
                 }
@@ -104,24 +105,39 @@ mod tests {
     fn masks_select_the_bits_a_package_changes() {
         let mut o = RobotOutputs::default();
         apply_io_package(
-            &package(&[("standard_digital_output_mask", RtdeValue::Uint8(0b1010)), ("standard_digital_output", RtdeValue::Uint8(0xFF))]),
+            &package(&[
+                ("standard_digital_output_mask", RtdeValue::Uint8(0b1010)),
+                ("standard_digital_output", RtdeValue::Uint8(0xFF)),
+            ]),
             &mut o,
         );
         assert_eq!(o.digital_output_bits, 0b1010);
         apply_io_package(
-            &package(&[("tool_digital_output_mask", RtdeValue::Uint8(1)), ("tool_digital_output", RtdeValue::Uint8(1))]),
+            &package(&[
+                ("tool_digital_output_mask", RtdeValue::Uint8(1)),
+                ("tool_digital_output", RtdeValue::Uint8(1)),
+            ]),
             &mut o,
         );
         assert_eq!(o.digital_output_bits, 0b1010 | 1 << 16);
         apply_io_package(
-            &package(&[("standard_digital_output_mask", RtdeValue::Uint8(0b10)), ("standard_digital_output", RtdeValue::Uint8(0))]),
+            &package(&[
+                ("standard_digital_output_mask", RtdeValue::Uint8(0b10)),
+                ("standard_digital_output", RtdeValue::Uint8(0)),
+            ]),
             &mut o,
         );
         assert_eq!(o.digital_output_bits, 0b1000 | 1 << 16);
         // Mask 0: nothing changes.
-        apply_io_package(&package(&[("speed_slider_mask", RtdeValue::Uint32(0)), ("speed_slider_fraction", RtdeValue::Double(0.2))]), &mut o);
+        apply_io_package(
+            &package(&[("speed_slider_mask", RtdeValue::Uint32(0)), ("speed_slider_fraction", RtdeValue::Double(0.2))]),
+            &mut o,
+        );
         assert_eq!(o.target_speed_fraction, 1.0);
-        apply_io_package(&package(&[("speed_slider_mask", RtdeValue::Uint32(1)), ("speed_slider_fraction", RtdeValue::Double(0.2))]), &mut o);
+        apply_io_package(
+            &package(&[("speed_slider_mask", RtdeValue::Uint32(1)), ("speed_slider_fraction", RtdeValue::Double(0.2))]),
+            &mut o,
+        );
         assert_eq!(o.target_speed_fraction, 0.2);
     }
 

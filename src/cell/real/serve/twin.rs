@@ -2,6 +2,7 @@
 
 use super::dashboard::{UrController, VirtualUrSetup};
 use super::pose::tcp_pose;
+use super::program::{ArmCommand, ProgramRunner};
 use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
@@ -11,14 +12,13 @@ use crate::cell::real::protocol::dynamixel::units::{
 };
 use crate::cell::real::protocol::dynamixel::{ControlTable, StreamDecoder, VirtualBus};
 use crate::cell::real::protocol::hyperion::{InterrogatorConfig, PeakFrame, PeakHeader, VirtualInterrogator};
-use super::program::{ArmCommand, ProgramRunner};
-use crate::cell::real::urscript::interp::CONTROL_PERIOD_S;
 use crate::cell::real::protocol::rtde::state::{
     RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
 };
 use crate::cell::real::protocol::rtde::{RobotOutputs, SharedInputs};
 use crate::cell::real::realtime::RealtimeOptions;
 use crate::cell::real::urscript::RtdeWatchdog;
+use crate::cell::real::urscript::interp::CONTROL_PERIOD_S;
 use crate::cell::sim::SimCell;
 use crate::hardware::{ARM_JOINTS, Cell, CellCommand, GroundTruth};
 use crate::run::scenario::PickPlaceScenario;

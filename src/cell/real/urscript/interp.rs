@@ -325,7 +325,8 @@ impl Interpreter {
                     }
                 }
                 Op::Call(name, argc, kw) => {
-                    let at = th.stack.len().checked_sub(argc + kw.len()).ok_or_else(|| err("stack underflow".into()))?;
+                    let at =
+                        th.stack.len().checked_sub(argc + kw.len()).ok_or_else(|| err("stack underflow".into()))?;
                     let mut args = th.stack.split_off(at);
                     let kwargs: Vec<(String, Value)> = kw.into_iter().zip(args.split_off(argc)).collect();
                     if let Some(f) = self.code.functions.get(&name).cloned() {
@@ -339,7 +340,8 @@ impl Interpreter {
                         th.frames.push(Frame { func: f, pc: 0, locals, program_body: false });
                         continue;
                     }
-                    let mut cx = Cx { host: &mut *host, arm: &mut self.arm, now, thread: th.id, period: CONTROL_PERIOD_S };
+                    let mut cx =
+                        Cx { host: &mut *host, arm: &mut self.arm, now, thread: th.id, period: CONTROL_PERIOD_S };
                     match builtins::call(&name, &args, &kwargs, &mut cx).map_err(err)? {
                         Outcome::Value(v) => th.stack.push(v),
                         Outcome::Sleep(v, t) => {
@@ -431,9 +433,7 @@ impl Interpreter {
         let global = match scope {
             Scope::Global => true,
             Scope::Local => frame.program_body,
-            Scope::Free => {
-                frame.program_body || (!frame.locals.contains_key(name) && self.globals.contains_key(name))
-            }
+            Scope::Free => frame.program_body || (!frame.locals.contains_key(name) && self.globals.contains_key(name)),
         };
         let map = if global { &mut self.globals } else { &mut frame.locals };
         if create {

@@ -120,16 +120,7 @@ fn max_abs(v: &[f64; 6]) -> f64 {
 impl Arm {
     /// An arm at rest at `q` \[rad\].
     pub fn new(q: [f64; 6]) -> Arm {
-        Arm {
-            q,
-            qd: [0.0; 6],
-            motion: Motion::Hold,
-            id: 0,
-            done: true,
-            owner: None,
-            servo_sent: None,
-            pending: None,
-        }
+        Arm { q, qd: [0.0; 6], motion: Motion::Hold, id: 0, done: true, owner: None, servo_sent: None, pending: None }
     }
 
     /// The setpoint \[rad\] (`get_target_joint_positions`).

@@ -43,8 +43,8 @@ const BLOCK_END: [&str; 3] = ["end", "elif", "else"];
 
 /// Names that cannot be variables.
 const KEYWORDS: [&str; 17] = [
-    "end", "elif", "else", "def", "thread", "if", "while", "return", "global", "local", "break", "continue",
-    "halt", "kill", "join", "and", "or",
+    "end", "elif", "else", "def", "thread", "if", "while", "return", "global", "local", "break", "continue", "halt",
+    "kill", "join", "and", "or",
 ];
 
 impl Parser {
@@ -517,7 +517,9 @@ mod tests {
 
     #[test]
     fn statements_and_precedence() {
-        let b = body("  x = 1 + 2 * 3\n  if x > 3 and not False:\n    y = p[0, 0, 0.1, 0, 0, 0]\n  elif x == 1:\n    y = 2\n  else:\n    y = -x\n  end");
+        let b = body(
+            "  x = 1 + 2 * 3\n  if x > 3 and not False:\n    y = p[0, 0, 0.1, 0, 0, 0]\n  elif x == 1:\n    y = 2\n  else:\n    y = -x\n  end",
+        );
         assert_eq!(b.len(), 2);
         match &b[0].kind {
             StmtKind::Assign { value: Expr::Binary(BinOp::Add, _, r), .. } => {
@@ -529,7 +531,9 @@ mod tests {
             StmtKind::If { branches, otherwise } => {
                 assert_eq!(branches.len(), 2);
                 assert_eq!(otherwise.len(), 1);
-                assert!(matches!(&branches[0].1[0].kind, StmtKind::Assign { value: Expr::Pose(p), .. } if p.len() == 6));
+                assert!(
+                    matches!(&branches[0].1[0].kind, StmtKind::Assign { value: Expr::Pose(p), .. } if p.len() == 6)
+                );
             }
             other => panic!("{other:?}"),
         }
@@ -538,11 +542,15 @@ mod tests {
 
     #[test]
     fn calls_keywords_threads_indexing_and_p_as_a_variable() {
-        let b = body("  x = # a comment, the value on the next line\n  0    y = 2\n  movej(q, a=1.4, v=1.05)\n  h = run t()\n  p[0] = p[0] * 2\n  global g = [1, 2]\n  thread t():\n    sync()\n  end");
+        let b = body(
+            "  x = # a comment, the value on the next line\n  0    y = 2\n  movej(q, a=1.4, v=1.05)\n  h = run t()\n  p[0] = p[0] * 2\n  global g = [1, 2]\n  thread t():\n    sync()\n  end",
+        );
         assert!(matches!(&b[0].kind, StmtKind::Assign { name, value: Expr::Lit(Value::Int(0)), .. } if name == "x"));
         assert!(matches!(&b[1].kind, StmtKind::Assign { name, .. } if name == "y"));
         let b = &b[2..];
-        assert!(matches!(&b[0].kind, StmtKind::Expr(Expr::Call { args, kwargs, .. }) if args.len() == 1 && kwargs.len() == 2));
+        assert!(
+            matches!(&b[0].kind, StmtKind::Expr(Expr::Call { args, kwargs, .. }) if args.len() == 1 && kwargs.len() == 2)
+        );
         assert!(matches!(&b[1].kind, StmtKind::Assign { value: Expr::Run(t), .. } if t == "t"));
         assert!(matches!(&b[2].kind, StmtKind::Assign { name, indices, .. } if name == "p" && indices.len() == 1));
         assert!(matches!(&b[3].kind, StmtKind::Assign { scope: Scope::Global, .. }));

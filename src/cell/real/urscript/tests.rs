@@ -56,7 +56,13 @@ impl Controller for Fake {
 
 impl Fake {
     fn new() -> Fake {
-        Fake { in_int: vec![0; 48], in_float: vec![0.0; 48], out_int: vec![0; 48], out_float: vec![0.0; 48], ..Default::default() }
+        Fake {
+            in_int: vec![0; 48],
+            in_float: vec![0.0; 48],
+            out_int: vec![0; 48],
+            out_float: vec![0.0; 48],
+            ..Default::default()
+        }
     }
 }
 
@@ -166,7 +172,9 @@ fn scoping_follows_the_manual_globals_first_then_locals() {
 #[test]
 fn an_unsupported_builtin_stops_the_program_naming_its_line() {
     let mut fake = Fake::new();
-    let src = program("  textmsg(\"before\")\n  sync()\n  force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,5,0,0,0], 2, [0.1,0.1,0.1,0.1,0.1,0.1])\n  textmsg(\"after\")\n");
+    let src = program(
+        "  textmsg(\"before\")\n  sync()\n  force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,5,0,0,0], 2, [0.1,0.1,0.1,0.1,0.1,0.1])\n  textmsg(\"after\")\n",
+    );
     let mut p = Interpreter::new(&src, [0.0; 6]).unwrap();
     run(&mut p, &mut fake, 0, 5);
     match p.status() {
@@ -218,7 +226,9 @@ fn runtime_errors_name_the_line_and_the_reason() {
 #[test]
 fn io_builtins_reach_the_controller() {
     let mut fake = Fake::new();
-    let src = program("  set_standard_digital_out(3, True)\n  set_tool_digital_out(1, True)\n  set_tool_digital_out(2, True)\n");
+    let src = program(
+        "  set_standard_digital_out(3, True)\n  set_tool_digital_out(1, True)\n  set_tool_digital_out(2, True)\n",
+    );
     let mut p = Interpreter::new(&src, [0.0; 6]).unwrap();
     run(&mut p, &mut fake, 0, 2);
     assert_eq!(fake.digital, vec![(DigitalOut::Standard, 3, true), (DigitalOut::Tool, 1, true)]);

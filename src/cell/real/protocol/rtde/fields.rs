@@ -201,9 +201,15 @@ pub fn input_type(name: &str) -> Option<RtdeType> {
 /// Whether an input name sets an output of the controller's IO (digital and analog outputs and
 /// their masks, the speed slider) rather than a register.
 pub fn is_io_input(name: &str) -> bool {
-    ["speed_slider_", "standard_digital_output", "configurable_digital_output", "tool_digital_output", "standard_analog_output_"]
-        .iter()
-        .any(|p| name.starts_with(p))
+    [
+        "speed_slider_",
+        "standard_digital_output",
+        "configurable_digital_output",
+        "tool_digital_output",
+        "standard_analog_output_",
+    ]
+    .iter()
+    .any(|p| name.starts_with(p))
 }
 
 #[cfg(test)]

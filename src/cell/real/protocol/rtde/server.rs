@@ -252,13 +252,8 @@ impl ServerSession {
         // Applied whether or not the session was started: SDU ur_rtde's RTDEIOInterface sets up
         // its input recipes and sends data packages without ever sending START, and works on real
         // controllers, so they take inputs from a session that has not started.
-        let io: Vec<(String, RtdeValue)> = recipe
-            .names
-            .iter()
-            .zip(&values)
-            .filter(|(n, _)| is_io_input(n))
-            .map(|(n, v)| (n.clone(), *v))
-            .collect();
+        let io: Vec<(String, RtdeValue)> =
+            recipe.names.iter().zip(&values).filter(|(n, _)| is_io_input(n)).map(|(n, v)| (n.clone(), *v)).collect();
         if !io.is_empty() {
             if shared.io_packages.len() >= MAX_IO_PACKAGES {
                 shared.io_packages.remove(0);
