@@ -201,7 +201,7 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
             assert!((target_pose[k] - expected_target[k]).abs() < 1e-9, "{target_pose:?} vs {expected_target:?}");
         }
     }
-    // Distinct physics steps only (the output may repeat a step's sample).
+    // Distinct samples only (a package may repeat the sample before it).
     let mut steps: Vec<(f64, [f64; 6], [f64; 6])> = Vec::new();
     for &(t, q, qd, ..) in &parsed {
         if steps.last().is_none_or(|s| t > s.0 + 1e-9) {
@@ -210,32 +210,41 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
     }
     let moved = steps.last().unwrap().1[0] - steps[0].1[0];
     assert!(moved > 0.15, "the arm followed: joint 0 moved {moved} rad");
-    // Over windows of about 50 ms inside the motion, the time-weighted mean of actual_qd (each
-    // value is the velocity over the step ending at its timestamp) equals the numerical derivative
-    // of actual_q. The mean speed is the commanded one, not five times it.
     let t_start = steps[0].0;
     let inside: Vec<_> = steps.iter().filter(|s| s.0 > t_start + 0.1 && s.0 < t_start + 0.55).collect();
-    assert!(inside.len() > 40, "{} steps sampled", inside.len());
-    let mut windows = 0;
-    for w in inside.windows(11) {
-        let (a, b) = (w[0], w[10]);
-        let dt = b.0 - a.0;
+    // A new sample in (nearly) every 2 ms package of the 500 Hz recipe, not one per 5 ms physics step.
+    assert!(inside.len() > 150, "{} distinct samples in 0.45 s", inside.len());
+    // actual_qd is the derivative of actual_q: between two samples with the same actual_qd (the
+    // arm moves at a constant rate within a physics step, and RTDE reports it interpolated between
+    // steps) the joints moved by exactly that speed times the time between them. It was five
+    // times the true speed in one sample of five, zero in the others.
+    let mut pairs = 0;
+    for p in inside.windows(2) {
+        let (a, b) = (p[0], p[1]);
         for j in [0, 4] {
-            let derivative = (b.1[j] - a.1[j]) / dt;
-            let integral: f64 = w.windows(2).map(|p| p[1].2[j] * (p[1].0 - p[0].0)).sum::<f64>() / dt;
-            assert!(
-                (derivative - integral).abs() < 0.05 * speed[j].abs() + 0.005,
-                "joint {j} over {:.3}..{:.3} s: dq/dt {derivative:.4} rad/s, mean actual_qd {integral:.4} rad/s",
-                a.0,
-                b.0
-            );
+            if a.2[j] == b.2[j] && a.2[j].abs() > 0.01 {
+                let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
+                assert!(
+                    (derivative - b.2[j]).abs() < 1e-6,
+                    "joint {j} over {:.4}..{:.4} s: dq/dt {derivative:.6} rad/s, actual_qd {:.6} rad/s",
+                    a.0,
+                    b.0,
+                    b.2[j]
+                );
+                pairs += 1;
+            }
         }
-        windows += 1;
     }
-    assert!(windows > 20);
+    assert!(pairs > 100, "{pairs} pairs within a step");
+    // Over the motion the time-weighted mean of actual_qd equals the mean speed.
+    let (a, b) = (inside[0], inside[inside.len() - 1]);
+    for j in [0, 4] {
+        let integral: f64 = inside.windows(2).map(|p| p[1].2[j] * (p[1].0 - p[0].0)).sum::<f64>() / (b.0 - a.0);
+        let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
+        assert!((integral - derivative).abs() < 0.05 * speed[j].abs(), "joint {j}: {integral} vs {derivative}");
+    }
     // The speed is the commanded one over the whole span (over one 50 ms window a target the
     // client sent a tick late on a loaded machine moves it by a quarter).
-    let (a, b) = (inside[0], inside[inside.len() - 1]);
     for j in [0, 4] {
         let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
         assert!((derivative - speed[j]).abs() < 0.1 * speed[j].abs(), "joint {j}: {derivative} vs {}", speed[j]);

@@ -201,6 +201,26 @@ pub fn open_bus(
     Ok((path, handle))
 }
 
+/// The arm RTDE reports at twin time `t` \[s\]: interpolated linearly between the physics states
+/// `before` and `after` (time \[s\], joints \[rad\]), `t` clamped to the span between them.
+///
+/// Why: the physics moves the arm once per step (5 ms), so reporting the latest step gave a 500 Hz
+/// client the same sample in two or three packages running. The kinematic arm moves at a constant
+/// rate within a step, so the interpolation is the arm's actual path. The physics steps once a
+/// tick's wait passes half of the step (`wait_until`), so the latest step ends within half a step
+/// of the twin's clock either way; at half a step behind the clock the sample is always between
+/// the last two steps: an interpolation, never an extrapolation. The cost: RTDE's samples are half a
+/// step (2.5 ms) older than before on average, and each is stamped with its own time.
+fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64, [f64; 6]) {
+    let span = after.0 - before.0;
+    if span <= 0.0 {
+        return (after.0, after.1);
+    }
+    let t = t.clamp(before.0, after.0);
+    let f = (t - before.0) / span;
+    (t, std::array::from_fn(|j| before.1[j] + (after.1[j] - before.1[j]) * f))
+}
+
 /// Runs the twin in real time on its own thread (the MuJoCo data stays on it).
 pub fn spawn(
     scenario: PickPlaceScenario,
@@ -233,6 +253,8 @@ pub fn spawn(
         // the last step's displacement over its duration (the kinematic arm moves at a constant
         // rate within a step), held until the next step changes them.
         let mut last_step = (first.time_s, first.arm_q, [first.growth_motor_rad, first.twine_motor_rad]);
+        // The arm at the step before: RTDE reports the arm interpolated between the two.
+        let mut step_before = (first.time_s, first.arm_q);
         let mut actual_qd = [0.0; ARM_JOINTS];
         // The motors' speeds, the same way (Present Velocity).
         let mut motor_rad_s = [0.0; 2];
@@ -322,8 +344,13 @@ pub fn spawn(
                 let dt = r.time_s - last_step.0;
                 actual_qd = std::array::from_fn(|j| (r.arm_q[j] - last_step.1[j]) / dt);
                 motor_rad_s = std::array::from_fn(|m| (motors_rad[m] - last_step.2[m]) / dt);
+                step_before = (last_step.0, last_step.1);
                 last_step = (r.time_s, r.arm_q, motors_rad);
             }
+            // What RTDE reports: the arm half a physics step behind the twin's clock, interpolated
+            // between the last two steps (see `rtde_sample`).
+            let (sample_s, sample_q) =
+                rtde_sample(step_before, (r.time_s, r.arm_q), k as f64 * period_s - 0.5 * timestep_s);
             // The load on each motor's output shaft: the tendon's tension on the twine spool; the
             // growth motor's load is not modelled (0).
             let motor_torque_nm = [0.0, cell.tendon_tension_n() * cell.twine_spool_radius_m()];
@@ -342,11 +369,11 @@ pub fn spawn(
                 o.runtime_state = runtime_state;
                 o.robot_mode = robot_mode;
                 o.safety_mode = safety_mode;
-                o.timestamp_s = r.time_s;
+                o.timestamp_s = sample_s;
                 o.actual_qd = actual_qd;
-                o.actual_q = r.arm_q;
+                o.actual_q = sample_q;
                 o.target_q = command.arm_q;
-                o.actual_tcp_pose = tcp_pose(&r.arm_q, &o.tcp_offset);
+                o.actual_tcp_pose = tcp_pose(&sample_q, &o.tcp_offset);
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
                 for (m, id) in motors.into_iter().enumerate() {
                     if let Some(t) = s.bus.table_mut(id) {
@@ -391,4 +418,20 @@ pub fn spawn(
         Ok(())
     };
     Ok(std::thread::Builder::new().name("twin".into()).spawn(run)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rtde_sample;
+
+    #[test]
+    fn rtde_samples_interpolate_between_the_last_two_steps_and_never_extrapolate() {
+        let (before, after) = ((0.010, [0.0; 6]), (0.015, [0.5; 6]));
+        let (t, q) = rtde_sample(before, after, 0.012);
+        assert_eq!(t, 0.012);
+        assert!((q[3] - 0.2).abs() < 1e-12, "{q:?}");
+        assert_eq!(rtde_sample(before, after, 0.020), (0.015, [0.5; 6]), "clamped to the latest step");
+        assert_eq!(rtde_sample(before, after, 0.001), (0.010, [0.0; 6]), "clamped to the step before");
+        assert_eq!(rtde_sample(after, after, 0.012), (0.015, [0.5; 6]), "no span: the latest step");
+    }
 }
