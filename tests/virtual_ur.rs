@@ -341,3 +341,50 @@ fn a_client_that_stops_sending_stops_the_follow_program() {
     assert_eq!(int(&s[2]), 1);
     serve.stop().unwrap();
 }
+
+/// Issue 17: programs are interpreted; one that the virtual controller cannot run stops with a
+/// logged error naming its line, the arm held, and `serve` goes on serving the next program.
+#[test]
+fn bad_programs_stop_with_their_line_in_the_log_and_serve_runs_the_next_one() {
+    let _turn = one_at_a_time();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21830)).unwrap();
+    let mut c = Rtde::start(serve.addrs[0], &["timestamp", "actual_q", "runtime_state", "output_int_register_3"], &[]);
+    let q0 = v6(&c.latest_after(Duration::from_millis(50))[1]);
+    let log_after = |serve: &ServeHandle, from: usize| -> Vec<String> {
+        serve.state.lock().unwrap().program_log.iter().skip(from).cloned().collect()
+    };
+    for (program, line, what) in [
+        // An unsupported builtin after a statement that ran.
+        (
+            "def bad():\n  textmsg(\"started\")\n  sync()\n  force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,5,0,0,0], 2, [0.1,0.1,0.1,0.1,0.1,0.1])\nend\n",
+            "line 4",
+            "force_mode",
+        ),
+        // An endless loop without sync(): a runtime error, not a hung twin.
+        ("def spin():\n  x = 0\n  while True:\n    x = x + 1\n  end\nend\n", "line 4", "endless loop"),
+        // A syntax error: the program does not start.
+        ("def broken():\n  x = (1 +\n  y = 2\nend\n", "line 3", "syntax error"),
+    ] {
+        let seen = serve.state.lock().unwrap().program_log.len();
+        upload(&serve, program);
+        let s = c.latest_after(Duration::from_millis(100));
+        assert_eq!(int(&s[2]), 1, "{program}: stopped");
+        let log = log_after(&serve, seen);
+        assert!(log.iter().any(|l| l.contains(line) && l.contains(what)), "{program}: {log:?}");
+        assert!(serve.running());
+        let q = v6(&s[1]);
+        assert!((0..6).all(|j| (q[j] - q0[j]).abs() < 1e-6), "the arm did not move: {q:?}");
+    }
+    // The next program runs: it writes a register and moves the base joint 0.05 rad.
+    let target: Vec<String> = (0..6).map(|j| format!("{}", q0[j] + if j == 0 { 0.05 } else { 0.0 })).collect();
+    let good = format!(
+        "def good():\n  write_output_integer_register(3, 42)\n  movej([{}], a=1, v=0.5)\n  textmsg(\"there\")\n  while True:\n    sync()\n  end\nend\n",
+        target.join(", ")
+    );
+    upload(&serve, &good);
+    let s = c.latest_after(Duration::from_millis(600));
+    assert_eq!((int(&s[2]), int(&s[3])), (2, 42), "playing, the register written");
+    assert!((v6(&s[1])[0] - (q0[0] + 0.05)).abs() < 1e-3, "moved: {:?}", v6(&s[1]));
+    assert!(serve.state.lock().unwrap().program_log.iter().any(|l| l == "there"));
+    serve.stop().unwrap();
+}
