@@ -347,7 +347,7 @@ fn a_client_that_stops_sending_stops_the_follow_program() {
 #[test]
 fn bad_programs_stop_with_their_line_in_the_log_and_serve_runs_the_next_one() {
     let _turn = one_at_a_time();
-    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21830)).unwrap();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21890)).unwrap();
     let mut c = Rtde::start(serve.addrs[0], &["timestamp", "actual_q", "runtime_state", "output_int_register_3"], &[]);
     let q0 = v6(&c.latest_after(Duration::from_millis(50))[1]);
     let log_after = |serve: &ServeHandle, from: usize| -> Vec<String> {
