@@ -290,3 +290,102 @@ proptest! {
         let _ = (RobotMode::parse_reply(&line), SafetyStatus::parse_reply(&line), PolyscopeVersion::parse_reply(&line));
     }
 }
+
+// ---------- URScript ----------
+
+/// A controller with nothing behind it: registers read 0, writes go nowhere.
+struct NullController;
+
+impl tendril::cell::real::urscript::Controller for NullController {
+    fn input_int(&self, _: usize) -> i32 {
+        0
+    }
+    fn input_float(&self, _: usize) -> f64 {
+        0.0
+    }
+    fn input_bool(&self, _: usize) -> bool {
+        false
+    }
+    fn set_output_int(&mut self, _: usize, _: i32) {}
+    fn set_output_float(&mut self, _: usize, _: f64) {}
+    fn set_output_bool(&mut self, _: usize, _: bool) {}
+    fn set_digital_out(&mut self, _: tendril::cell::real::urscript::DigitalOut, _: usize, _: bool) {}
+    fn set_analog_out(&mut self, _: usize, _: f64) {}
+    fn actual_q(&self) -> [f64; 6] {
+        [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]
+    }
+    fn input_packages(&self) -> u64 {
+        0
+    }
+    fn set_watchdog(&mut self, _: tendril::cell::real::urscript::RtdeWatchdog) {}
+    fn message(&mut self, _: &str) {}
+}
+
+/// Program text made of URScript's own pieces, so that the parser gets past the first token.
+fn urscript_text() -> impl Strategy<Value = String> {
+    let piece = prop_oneof![
+        Just("def "),
+        Just("thread "),
+        Just("end\n"),
+        Just("if "),
+        Just("elif "),
+        Just("else"),
+        Just("while "),
+        Just("return "),
+        Just("global "),
+        Just("run "),
+        Just("kill "),
+        Just("join "),
+        Just("x"),
+        Just("f"),
+        Just("p["),
+        Just("["),
+        Just("]"),
+        Just("("),
+        Just(")"),
+        Just(":"),
+        Just(","),
+        Just("="),
+        Just("=="),
+        Just("+"),
+        Just("-"),
+        Just("*"),
+        Just("/"),
+        Just("%"),
+        Just(" and "),
+        Just(" not "),
+        Just("1"),
+        Just("0.5"),
+        Just("\"s\""),
+        Just("True"),
+        Just("\n"),
+        Just("sync()"),
+        Just("movej("),
+        Just("servoj("),
+        Just("speedj("),
+        Just("stopj(1)"),
+        Just("sleep(0.01)"),
+        Just("textmsg("),
+        Just("# c\n"),
+        Just("1e308"),
+    ];
+    prop::collection::vec(piece, 0..60).prop_map(|v| format!("def prog():\n{}\nend\n", v.concat()))
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn urscript_never_panics_on_arbitrary_text(text in ".{0,300}") {
+        let _ = tendril::cell::real::urscript::Interpreter::new(&text, [0.0; 6]);
+    }
+
+    #[test]
+    fn urscript_programs_of_its_own_pieces_parse_or_fail_and_run_without_panicking(text in urscript_text()) {
+        if let Ok(mut p) = tendril::cell::real::urscript::Interpreter::new(&text, [0.0; 6]) {
+            for k in 0..20 {
+                let _ = p.step(k as f64 * 0.002, &mut NullController);
+            }
+        }
+    }
+}

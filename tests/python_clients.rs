@@ -1,5 +1,7 @@
 //! Independent clients from PyPI against the virtual devices: SDU `ur_rtde` reads `actual_q`
-//! from the virtual UR5e and drives its dashboard server, ROBOTIS `dynamixel-sdk` pings the virtual
+//! from the virtual UR5e, drives its dashboard server, drives the arm through its own control
+//! script (`RTDEControlInterface`: moveJ, moveL, servoJ, speedJ, stops) and sets IO outputs
+//! (`RTDEIOInterface`), ROBOTIS `dynamixel-sdk` pings the virtual
 //! MX-106, writes/reads Goal and Present Position over the pseudo-terminal, gets the e-manual's
 //! status errors and sync/bulk reads the pair.
 //!
@@ -157,4 +159,83 @@ fn ur_rtde_dashboard_client_drives_the_virtual_dashboard_server() {
     assert_eq!(v["paused_state"], "PAUSED /programs/follow.urp");
     assert_eq!(v["running_after_stop"], false);
     assert_eq!(program, tendril::cell::real::serve::ProgramState::Stopped);
+}
+
+fn close(a: &serde_json::Value, b: &serde_json::Value, tol: f64, what: &str) {
+    let (a, b): (Vec<f64>, Vec<f64>) =
+        (serde_json::from_value(a.clone()).unwrap(), serde_json::from_value(b.clone()).unwrap());
+    assert_eq!(a.len(), b.len(), "{what}");
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() < tol, "{what}: {a:?} vs {b:?} (tolerance {tol})");
+    }
+}
+
+/// Issue 17: ur_rtde's `RTDEControlInterface` uploads its own control script (threads, a command
+/// loop on the RTDE registers) and could not drive the twin: every move timed out. The virtual
+/// controller now interprets it.
+#[test]
+fn ur_rtde_control_interface_moves_the_twin_and_io_interface_sets_outputs() {
+    let _turn = one_at_a_time();
+    let Some(python) = python() else { return };
+    // ur_rtde always uses 30004, 30003 and 29999: a loopback address of its own.
+    let mut config = ServeConfig::loopback().with_port_base(21880);
+    config.bind = IpAddr::V4(Ipv4Addr::new(127, 0, 0, 75));
+    (config.rtde_port, config.script_port, config.realtime_script_port, config.dashboard_port) =
+        (30004, 30002, 30003, 29999);
+    let serve = start(&short_lift(&[]), &config).unwrap();
+    let v = run_script(&python, "ur_rtde_control.py", &["127.0.0.75"]);
+    let (log, running) = {
+        let s = serve.state.lock().unwrap();
+        (s.program_log.iter().cloned().collect::<Vec<_>>(), serve.running())
+    };
+    serve.stop().unwrap();
+    eprintln!("{v}");
+    assert!(running, "serve survived the client");
+    assert_eq!(v["program_running"], true, "the uploaded control script plays");
+    // moveJ there and back: the arm within 1 mrad of each target.
+    for ok in ["movej_ok", "movej_back_ok", "movel_ok", "servo_stop_ok", "speedj_ok", "speed_stop_ok", "movej_async_ok"]
+    {
+        assert_eq!(v[ok], true, "{ok}: {v}");
+    }
+    close(&v["after_movej"], &v["q1"], 1e-3, "moveJ");
+    close(&v["after_movej_back"], &v["q0"], 1e-3, "moveJ back");
+    // 0.2 rad at 1 rad/s, 2 rad/s² is a triangle of 2 sqrt(0.1) = 0.63 s; the call waits for it.
+    let movej_s = v["movej_s"].as_f64().unwrap();
+    assert!((0.6..2.0).contains(&movej_s), "moveJ took {movej_s} s");
+    // moveL 3 cm along x and 5 cm down: the TCP there within 1 mm, the orientation unchanged.
+    let (got, want): (Vec<f64>, Vec<f64>) =
+        (serde_json::from_value(v["after_movel"].clone()).unwrap(), serde_json::from_value(v["p1"].clone()).unwrap());
+    let to_pose = |p: &[f64]| tendril::cell::real::serve::pose::pose_from_vector(&std::array::from_fn(|k| p[k]));
+    let (got, want) = (to_pose(&got), to_pose(&want));
+    let off = (got.translation.vector - want.translation.vector).norm();
+    assert!(off < 1e-3, "moveL ended {off} m from its target");
+    assert!(got.rotation.angle_to(&want.rotation) < 2e-3, "moveL kept the orientation");
+    assert!(log.iter().any(|l| l == "movel done"), "the script's own log: {log:?}");
+    // servoJ: the arm followed the streamed targets (sampled every 0.1 s, within 0.02 rad, the
+    // distance covered in a few cycles) and stopped where the last one was.
+    let follow: Vec<[f64; 2]> = serde_json::from_value(v["servo_follow"].clone()).unwrap();
+    assert_eq!(follow.len(), 10);
+    for [target, actual] in &follow {
+        assert!((target - actual).abs() < 0.02, "servoJ: target {target}, arm {actual}: {follow:?}");
+    }
+    let moved = v["servo_last"][0].as_f64().unwrap() - v["servo_start"][0].as_f64().unwrap();
+    assert!(moved > 0.15, "the servo arc moved the base {moved} rad");
+    close(&v["after_servo_stop"], &v["servo_last"], 2e-3, "servoStop");
+    // speedJ: the commanded speed once ramped up; speedStop and stopJ bring it to rest.
+    let speed = v["speed_mean"].as_f64().unwrap();
+    assert!((speed - 0.3).abs() < 0.03, "speedJ at 0.3 rad/s measured {speed}");
+    close(&v["after_speed_stop_qd"], &serde_json::json!([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 1e-6, "speedStop");
+    assert!(v["drift_after_speed_stop"].as_f64().unwrap().abs() < 1e-6);
+    let before = v["moving_before_stopj"][5].as_f64().unwrap();
+    assert!((before + 0.3).abs() < 0.03, "the asynchronous moveJ at its 0.3 rad/s: {before}");
+    close(&v["after_stopj_qd"], &serde_json::json!([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]), 1e-6, "stopJ");
+    let (start, end) = (v["stopj_start"][5].as_f64().unwrap(), v["after_stopj"][5].as_f64().unwrap());
+    assert!(end < start - 0.2 && end > start - 0.45, "stopped part way along the 0.6 rad: {start} -> {end}");
+    // RTDEIOInterface: the outputs as the receive interface reads them back.
+    assert_eq!(v["io_ok"], serde_json::json!([true, true, true, true]));
+    assert_eq!(v["digital_bits"], (1 << 3) + (1 << 17), "DO3 and tool output 1 (bit 16 + 1)");
+    assert_eq!(v["digital_bits_after_clear"], 1 << 17);
+    assert!((v["speed_fraction"].as_f64().unwrap() - 0.4).abs() < 1e-12);
+    assert!((v["analog1"].as_f64().unwrap() - 3.0).abs() < 1e-9, "0.3 of 10 V: {v}");
+    assert_eq!(v["running_after_stop_script"], false, "stopScript ends the program");
 }

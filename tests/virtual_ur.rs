@@ -201,7 +201,7 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
             assert!((target_pose[k] - expected_target[k]).abs() < 1e-9, "{target_pose:?} vs {expected_target:?}");
         }
     }
-    // Distinct physics steps only (the output may repeat a step's sample).
+    // Distinct samples only (a package may repeat the sample before it).
     let mut steps: Vec<(f64, [f64; 6], [f64; 6])> = Vec::new();
     for &(t, q, qd, ..) in &parsed {
         if steps.last().is_none_or(|s| t > s.0 + 1e-9) {
@@ -210,32 +210,41 @@ fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
     }
     let moved = steps.last().unwrap().1[0] - steps[0].1[0];
     assert!(moved > 0.15, "the arm followed: joint 0 moved {moved} rad");
-    // Over windows of about 50 ms inside the motion, the time-weighted mean of actual_qd (each
-    // value is the velocity over the step ending at its timestamp) equals the numerical derivative
-    // of actual_q. The mean speed is the commanded one, not five times it.
     let t_start = steps[0].0;
     let inside: Vec<_> = steps.iter().filter(|s| s.0 > t_start + 0.1 && s.0 < t_start + 0.55).collect();
-    assert!(inside.len() > 40, "{} steps sampled", inside.len());
-    let mut windows = 0;
-    for w in inside.windows(11) {
-        let (a, b) = (w[0], w[10]);
-        let dt = b.0 - a.0;
+    // A new sample in (nearly) every 2 ms package of the 500 Hz recipe, not one per 5 ms physics step.
+    assert!(inside.len() > 150, "{} distinct samples in 0.45 s", inside.len());
+    // actual_qd is the derivative of actual_q: between two samples with the same actual_qd (the
+    // arm moves at a constant rate within a physics step, and RTDE reports it interpolated between
+    // steps) the joints moved by exactly that speed times the time between them. It was five
+    // times the true speed in one sample of five, zero in the others.
+    let mut pairs = 0;
+    for p in inside.windows(2) {
+        let (a, b) = (p[0], p[1]);
         for j in [0, 4] {
-            let derivative = (b.1[j] - a.1[j]) / dt;
-            let integral: f64 = w.windows(2).map(|p| p[1].2[j] * (p[1].0 - p[0].0)).sum::<f64>() / dt;
-            assert!(
-                (derivative - integral).abs() < 0.05 * speed[j].abs() + 0.005,
-                "joint {j} over {:.3}..{:.3} s: dq/dt {derivative:.4} rad/s, mean actual_qd {integral:.4} rad/s",
-                a.0,
-                b.0
-            );
+            if a.2[j] == b.2[j] && a.2[j].abs() > 0.01 {
+                let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
+                assert!(
+                    (derivative - b.2[j]).abs() < 1e-6,
+                    "joint {j} over {:.4}..{:.4} s: dq/dt {derivative:.6} rad/s, actual_qd {:.6} rad/s",
+                    a.0,
+                    b.0,
+                    b.2[j]
+                );
+                pairs += 1;
+            }
         }
-        windows += 1;
     }
-    assert!(windows > 20);
+    assert!(pairs > 100, "{pairs} pairs within a step");
+    // Over the motion the time-weighted mean of actual_qd equals the mean speed.
+    let (a, b) = (inside[0], inside[inside.len() - 1]);
+    for j in [0, 4] {
+        let integral: f64 = inside.windows(2).map(|p| p[1].2[j] * (p[1].0 - p[0].0)).sum::<f64>() / (b.0 - a.0);
+        let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
+        assert!((integral - derivative).abs() < 0.05 * speed[j].abs(), "joint {j}: {integral} vs {derivative}");
+    }
     // The speed is the commanded one over the whole span (over one 50 ms window a target the
     // client sent a tick late on a loaded machine moves it by a quarter).
-    let (a, b) = (inside[0], inside[inside.len() - 1]);
     for j in [0, 4] {
         let derivative = (b.1[j] - a.1[j]) / (b.0 - a.0);
         assert!((derivative - speed[j]).abs() < 0.1 * speed[j].abs(), "joint {j}: {derivative} vs {}", speed[j]);
@@ -330,5 +339,52 @@ fn a_client_that_stops_sending_stops_the_follow_program() {
     let s = c.latest_after(Duration::from_millis(50));
     assert!((v6(&s[1])[0] - held[0]).abs() < 1e-3, "the arm stays stopped");
     assert_eq!(int(&s[2]), 1);
+    serve.stop().unwrap();
+}
+
+/// Issue 17: programs are interpreted; one that the virtual controller cannot run stops with a
+/// logged error naming its line, the arm held, and `serve` goes on serving the next program.
+#[test]
+fn bad_programs_stop_with_their_line_in_the_log_and_serve_runs_the_next_one() {
+    let _turn = one_at_a_time();
+    let serve = start(&short_lift(&[]), &ServeConfig::loopback().with_port_base(21890)).unwrap();
+    let mut c = Rtde::start(serve.addrs[0], &["timestamp", "actual_q", "runtime_state", "output_int_register_3"], &[]);
+    let q0 = v6(&c.latest_after(Duration::from_millis(50))[1]);
+    let log_after = |serve: &ServeHandle, from: usize| -> Vec<String> {
+        serve.state.lock().unwrap().program_log.iter().skip(from).cloned().collect()
+    };
+    for (program, line, what) in [
+        // An unsupported builtin after a statement that ran.
+        (
+            "def bad():\n  textmsg(\"started\")\n  sync()\n  force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,5,0,0,0], 2, [0.1,0.1,0.1,0.1,0.1,0.1])\nend\n",
+            "line 4",
+            "force_mode",
+        ),
+        // An endless loop without sync(): a runtime error, not a hung twin.
+        ("def spin():\n  x = 0\n  while True:\n    x = x + 1\n  end\nend\n", "line 4", "endless loop"),
+        // A syntax error: the program does not start.
+        ("def broken():\n  x = (1 +\n  y = 2\nend\n", "line 3", "syntax error"),
+    ] {
+        let seen = serve.state.lock().unwrap().program_log.len();
+        upload(&serve, program);
+        let s = c.latest_after(Duration::from_millis(100));
+        assert_eq!(int(&s[2]), 1, "{program}: stopped");
+        let log = log_after(&serve, seen);
+        assert!(log.iter().any(|l| l.contains(line) && l.contains(what)), "{program}: {log:?}");
+        assert!(serve.running());
+        let q = v6(&s[1]);
+        assert!((0..6).all(|j| (q[j] - q0[j]).abs() < 1e-6), "the arm did not move: {q:?}");
+    }
+    // The next program runs: it writes a register and moves the base joint 0.05 rad.
+    let target: Vec<String> = (0..6).map(|j| format!("{}", q0[j] + if j == 0 { 0.05 } else { 0.0 })).collect();
+    let good = format!(
+        "def good():\n  write_output_integer_register(3, 42)\n  movej([{}], a=1, v=0.5)\n  textmsg(\"there\")\n  while True:\n    sync()\n  end\nend\n",
+        target.join(", ")
+    );
+    upload(&serve, &good);
+    let s = c.latest_after(Duration::from_millis(600));
+    assert_eq!((int(&s[2]), int(&s[3])), (2, 42), "playing, the register written");
+    assert!((v6(&s[1])[0] - (q0[0] + 0.05)).abs() < 1e-3, "moved: {:?}", v6(&s[1]));
+    assert!(serve.state.lock().unwrap().program_log.iter().any(|l| l == "there"));
     serve.stop().unwrap();
 }

@@ -1,4 +1,13 @@
-//! The URScript program the real path sends to the controller's secondary interface (TCP 30002).
+//! URScript: the program the real path sends to the controller's secondary interface (TCP 30002),
+//! and the interpreter the virtual UR5e (`tendril serve`) runs programs with.
+//!
+//! The interpreter, sans-IO (the arm and the RTDE registers come through
+//! [`interp::Controller`]): [`lexer`] → [`parser`] ([`ast`]) → [`compile`] (a stack code a thread
+//! can stop in at any wait) → [`interp`] (threads in the controller's 2 ms cycle), with
+//! [`value`] (types and arithmetic), [`builtins`] and [`motion`] (the setpoint generator).
+//!
+//! Our program, `urscript/follow.script`, runs through that interpreter like any other.
+//! What it does:
 //!
 //! The program (`urscript/follow.script`, written by this project) loops forever:
 //! - `input_int_register_24` = 1: read the six joint targets from `input_double_register_24..29`
@@ -20,6 +29,35 @@
 //! The client writes the targets and the enable flag in one RTDE input recipe, so a target and its
 //! enable always arrive together; speed and acceleration limits are applied before (see
 //! [`crate::cell::real::limits`]). The controller's own safety limits still apply on top.
+
+pub mod ast;
+pub mod builtins;
+pub mod compile;
+pub mod interp;
+pub mod lexer;
+pub mod motion;
+pub mod parser;
+pub mod value;
+
+pub use interp::{Controller, DigitalOut, Interpreter, Status};
+
+/// An error in a program: where and what. Line 0 means no single line (a motion that fails
+/// between calls, such as a `movel` through an unreachable pose).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ScriptError {
+    /// Line number, 1-based (0: not tied to a line).
+    pub line: u32,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl std::fmt::Display for ScriptError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.line > 0 { write!(f, "line {}: {}", self.line, self.message) } else { write!(f, "{}", self.message) }
+    }
+}
+
+impl std::error::Error for ScriptError {}
 
 /// The program text (newline-terminated `def ... end`, as the secondary interface expects).
 pub const FOLLOW_SCRIPT: &str = include_str!("urscript/follow.script");
@@ -60,41 +98,6 @@ pub struct RtdeWatchdog {
     pub action: WatchdogAction,
 }
 
-/// The program's `rtde_set_watchdog` call, if any (comments skipped); an error names what is
-/// wrong with a malformed call (a real controller would fail the program at that line).
-pub fn find_watchdog(text: &str) -> Result<Option<RtdeWatchdog>, String> {
-    const CALL: &str = "rtde_set_watchdog(";
-    for line in text.lines() {
-        let code = line.split('#').next().unwrap_or("").trim();
-        let Some(start) = code.find(CALL) else { continue };
-        let rest = &code[start + CALL.len()..];
-        let args = rest.rsplit_once(')').map(|(a, _)| a).ok_or_else(|| format!("unclosed call: {code}"))?;
-        let parts: Vec<&str> = args.split(',').map(str::trim).collect();
-        let unquote = |s: &str| -> Option<String> {
-            let s = s.strip_prefix('"').and_then(|s| s.strip_suffix('"'))?;
-            Some(s.to_string())
-        };
-        let (variable, frequency, action) = match parts.as_slice() {
-            [v, f] => (*v, *f, "\"pause\""),
-            [v, f, a] => (*v, *f, a.strip_prefix("action=").unwrap_or(a).trim()),
-            _ => return Err(format!("rtde_set_watchdog takes 2 or 3 arguments: {code}")),
-        };
-        let variable = unquote(variable).ok_or_else(|| format!("variable name must be a string: {code}"))?;
-        let min_frequency_hz: f64 = frequency.parse().map_err(|_| format!("min_frequency must be a number: {code}"))?;
-        if !(min_frequency_hz.is_finite() && min_frequency_hz > 0.0) {
-            return Err(format!("min_frequency must be positive: {code}"));
-        }
-        let action = match unquote(action).map(|a| a.to_ascii_lowercase()).as_deref() {
-            Some("ignore") => WatchdogAction::Ignore,
-            Some("pause") => WatchdogAction::Pause,
-            Some("stop") => WatchdogAction::Stop,
-            _ => return Err(format!("action must be \"ignore\", \"pause\" or \"stop\": {code}")),
-        };
-        return Ok(Some(RtdeWatchdog { variable, min_frequency_hz, action }));
-    }
-    Ok(None)
-}
-
 /// Whether `text` looks like a complete program: a `def name():` line and a final `end`.
 pub fn is_complete_program(text: &str) -> bool {
     let lines: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')).collect();
@@ -102,48 +105,4 @@ pub fn is_complete_program(text: &str) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_script_is_a_complete_program_using_the_documented_registers() {
-        assert!(is_complete_program(FOLLOW_SCRIPT));
-        assert!(FOLLOW_SCRIPT.contains("read_input_integer_register(24)"));
-        for i in 24..30 {
-            assert!(FOLLOW_SCRIPT.contains(&format!("read_input_float_register({i})")));
-        }
-        assert!(!is_complete_program("def f():\n  stopj(1)\n"));
-        assert_eq!(input_names().len(), 7);
-    }
-
-    #[test]
-    fn the_follow_program_sets_a_2_hz_stop_watchdog_on_the_enable_register() {
-        let w = find_watchdog(FOLLOW_SCRIPT).unwrap().unwrap();
-        assert_eq!(w.variable, format!("input_int_register_{ENABLE_REGISTER}"));
-        assert_eq!(w.min_frequency_hz, 2.0);
-        assert_eq!(w.action, WatchdogAction::Stop);
-    }
-
-    #[test]
-    fn watchdog_calls_are_parsed_as_the_manual_defines_them() {
-        let w = |s: &str| find_watchdog(&format!("def f():\n  {s}\nend\n"));
-        assert_eq!(w("sync()").unwrap(), None);
-        assert_eq!(w("# rtde_set_watchdog(\"x\", 1)").unwrap(), None);
-        let p = w("rtde_set_watchdog(\"speed_slider_mask\", 2.5)").unwrap().unwrap();
-        assert_eq!((p.min_frequency_hz, p.action), (2.5, WatchdogAction::Pause), "pause is the default");
-        assert_eq!(
-            w("rtde_set_watchdog(\"a\", 1, action=\"IGNORE\")").unwrap().unwrap().action,
-            WatchdogAction::Ignore
-        );
-        for bad in [
-            "rtde_set_watchdog(a, 1)",
-            "rtde_set_watchdog(\"a\", 0)",
-            "rtde_set_watchdog(\"a\", x)",
-            "rtde_set_watchdog(\"a\", 1, \"halt\")",
-            "rtde_set_watchdog(\"a\")",
-            "rtde_set_watchdog(\"a\", 1",
-        ] {
-            assert!(w(bad).is_err(), "{bad}");
-        }
-    }
-}
+mod tests;

@@ -44,6 +44,10 @@ pub enum Command {
     CloseSafetyPopup,
     /// `unlock protective stop`.
     UnlockProtectiveStop,
+    /// `get serial number` (PolyScope 5.6 and later; SDU ur_rtde's control interface asks).
+    GetSerialNumber,
+    /// `get robot model`.
+    GetRobotModel,
     /// `quit`: the server replies and closes the connection.
     Quit,
     /// Anything else, as received.
@@ -71,6 +75,8 @@ impl Command {
             "safetymode" => Command::SafetyMode,
             "polyscopeversion" => Command::PolyscopeVersion,
             "close safety popup" => Command::CloseSafetyPopup,
+            "get serial number" => Command::GetSerialNumber,
+            "get robot model" => Command::GetRobotModel,
             "unlock protective stop" => Command::UnlockProtectiveStop,
             "quit" => Command::Quit,
             _ if lower.starts_with("load ") => Command::Load(trimmed[5..].trim().to_string()),
@@ -97,6 +103,8 @@ impl Command {
             Command::PolyscopeVersion => "PolyscopeVersion",
             Command::CloseSafetyPopup => "close safety popup",
             Command::UnlockProtectiveStop => "unlock protective stop",
+            Command::GetSerialNumber => "get serial number",
+            Command::GetRobotModel => "get robot model",
             Command::Quit => "quit",
             Command::Unknown(text) => return format!("{text}\n"),
         };

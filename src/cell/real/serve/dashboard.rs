@@ -142,6 +142,8 @@ pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bo
         Command::Pause => reply::PAUSE_FAILED.into(),
         Command::Load(file) if file.ends_with(".urp") => {
             s.ur.loaded_program = Some(file.clone());
+            // The one program a `.urp` stands for: the follow program.
+            s.program_source = None;
             s.program = ProgramState::Stopped;
             loading(file)
         }
@@ -160,6 +162,10 @@ pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bo
                 reply::PROTECTIVE_STOP_RELEASING.into()
             }
         },
+        // Ours: a UR serial number is digits (year, model, number); ur_rtde checks only that.
+        Command::GetSerialNumber if s.ur.has_remote_control() => "20215500001".into(),
+        Command::GetSerialNumber => not_understood("get serial number"),
+        Command::GetRobotModel => "UR5".into(),
         Command::Quit => return (reply::DISCONNECTED.into(), true),
         Command::Unknown(text) => not_understood(text),
     };

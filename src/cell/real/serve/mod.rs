@@ -1,13 +1,14 @@
 //! Virtual devices: the twin ([`crate::cell::sim::SimCell`] stepped in real time) behind the real protocols.
 //!
 //! - RTDE on `rtde_port` (30004) and URScript on `script_port` (30002) and `realtime_script_port`
-//!   (30003), a dashboard server on `dashboard_port` (29999, [`dashboard`]): the
-//!   virtual controller "runs" an uploaded program by doing what `follow.script` does (follow
-//!   `input_double_register_24..29` while `input_int_register_24` = 1, else hold); see
-//!   [`crate::cell::real::urscript`]. The program's `rtde_set_watchdog` call is honoured (the
-//!   program stops or pauses when the watched input is not written in time); targets beyond the
-//!   UR5e's joint range or speed, or non-finite, put the arm in a protective stop ([`safety`])
-//!   until unlocked on the dashboard or a fresh program upload. `actual_TCP_pose` and `target_TCP_pose` come from [`pose`].
+//!   (30003), a dashboard server on `dashboard_port` (29999, [`dashboard`]): the virtual
+//!   controller runs an uploaded program with its URScript interpreter
+//!   ([`crate::cell::real::urscript`], [`program`]), our follow program and SDU ur_rtde's control
+//!   script alike. Its `rtde_set_watchdog` call is honoured (the program stops or pauses when the
+//!   watched input is not written in time); setpoints beyond the UR5e's joint range or speed, or
+//!   non-finite, put the arm in a protective stop ([`safety`]) until unlocked on the dashboard or a
+//!   fresh program upload. IO outputs and the speed slider follow RTDE inputs ([`io`]).
+//!   `actual_TCP_pose` and `target_TCP_pose` come from [`pose`].
 //! - Dynamixel: two MX-106 at the scenario's `hardware.growth_id` and `hardware.twine_id` (1, 2 by
 //!   default) on a pseudo-terminal (its path in [`ServeHandle::pty_path`]); Goal Position drives
 //!   the twin's motors, Present Position reports them; Baud Rate reads `hardware.dxl_baud`.
@@ -22,8 +23,10 @@
 //! Nothing here panics on input.
 
 pub mod dashboard;
+pub mod io;
 mod net;
 pub mod pose;
+pub mod program;
 pub mod safety;
 mod twin;
 

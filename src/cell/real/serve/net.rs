@@ -6,7 +6,7 @@ use super::twin::ProgramState;
 use super::{ServeConfig, UrAddrs};
 use crate::cell::real::protocol::dashboard::{Command, GREETING, RobotMode};
 use crate::cell::real::protocol::rtde::{ServerConfig, ServerSession};
-use crate::cell::real::urscript::{find_watchdog, is_complete_program};
+use crate::cell::real::urscript::is_complete_program;
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -16,6 +16,9 @@ use tokio::sync::watch;
 
 /// Largest URScript program accepted [bytes].
 const MAX_PROGRAM_LEN: usize = 1 << 20;
+/// How long a script connection must stay quiet after a complete-looking program before the
+/// program is taken.
+const PROGRAM_SETTLE: Duration = Duration::from_millis(50);
 /// A client sending more than this without completing a frame is dropped [bytes].
 const MAX_PENDING: usize = 1 << 20;
 
@@ -135,50 +138,40 @@ async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Rece
     lock(&state).inputs.release(id);
 }
 
-/// The secondary interface: a complete `def ... end` program starts following.
+/// The secondary interface: a complete `def ... end` program replaces the running one and plays.
 async fn serve_script(mut socket: TcpStream, state: Shared) {
     let mut text = Vec::new();
     let mut chunk = [0u8; 4096];
     loop {
-        let read = tokio::time::timeout(Duration::from_secs(2), socket.read(&mut chunk)).await;
-        match read {
+        // A text that ends in `end` may still be a part: a large program (SDU ur_rtde's is 40 kB)
+        // arrives in pieces, any of which can end with a nested block's `end`. So the program is
+        // taken once the client has sent nothing more for a moment (or closed the connection).
+        let complete = std::str::from_utf8(&text).is_ok_and(is_complete_program);
+        let wait = if complete { PROGRAM_SETTLE } else { Duration::from_secs(2) };
+        match tokio::time::timeout(wait, socket.read(&mut chunk)).await {
             Ok(Ok(n)) if n > 0 && text.len() + n <= MAX_PROGRAM_LEN => text.extend_from_slice(&chunk[..n]),
             _ => break,
-        }
-        if let Ok(t) = std::str::from_utf8(&text)
-            && is_complete_program(t)
-        {
-            break;
         }
     }
     let Ok(program) = std::str::from_utf8(&text) else { return };
     if !is_complete_program(program) {
         return;
     }
-    // A program whose watchdog call is malformed fails at that line on a real controller: it
-    // does not run (and the one before it has been replaced).
-    let watchdog = find_watchdog(program);
     let mut s = lock(&state);
     // In local control (PolyScope 5.6 and later) the script ports take no programs; with the
     // robot powered off or its brakes engaged a program cannot start.
     if !s.ur.accepts_programs() || s.ur.robot_mode != RobotMode::Running {
         return;
     }
+    // The twin's program runner parses and starts it (a syntax error is logged, the program
+    // does not start, and the one before it has been replaced).
+    s.program_source = Some(program.to_string());
     s.program_uploads += 1;
+    s.program = ProgramState::Playing;
     // A fresh upload also clears a protective stop (see `safety`; a real controller wants
     // `unlock protective stop` on the dashboard, which the virtual one takes as well).
     s.protective_stop = None;
     s.ur.protective_stop_at = None;
-    match watchdog {
-        Ok(w) => {
-            s.watchdog = w;
-            s.program = ProgramState::Playing;
-        }
-        Err(_) => {
-            s.watchdog = None;
-            s.program = ProgramState::Stopped;
-        }
-    }
 }
 
 /// Longest dashboard command line accepted [bytes].

@@ -2,10 +2,10 @@
 
 use super::dashboard::{UrController, VirtualUrSetup};
 use super::pose::tcp_pose;
+use super::program::{ArmCommand, ProgramRunner};
 use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
-use crate::cell::real::protocol::dashboard::RobotMode;
 use crate::cell::real::protocol::dynamixel::control_table::addr;
 use crate::cell::real::protocol::dynamixel::units::{
     baud_rate_code, present_current_units, present_velocity_units, rad_to_ticks, ticks_to_rad,
@@ -17,7 +17,8 @@ use crate::cell::real::protocol::rtde::state::{
 };
 use crate::cell::real::protocol::rtde::{RobotOutputs, SharedInputs};
 use crate::cell::real::realtime::RealtimeOptions;
-use crate::cell::real::urscript::{ENABLE_REGISTER, FOLLOWING_REGISTER, RtdeWatchdog, TARGET_REGISTER, WatchdogAction};
+use crate::cell::real::urscript::RtdeWatchdog;
+use crate::cell::real::urscript::interp::CONTROL_PERIOD_S;
 use crate::cell::sim::SimCell;
 use crate::hardware::{ARM_JOINTS, Cell, CellCommand, GroundTruth};
 use crate::run::scenario::PickPlaceScenario;
@@ -74,13 +75,18 @@ pub struct DeviceState {
     pub outputs: RobotOutputs,
     /// What RTDE clients wrote.
     pub inputs: SharedInputs,
-    /// The program that came in on the secondary interface: it plays from its upload until its
-    /// RTDE watchdog or a protective stop stops it.
+    /// The program's state: it plays from its upload until it ends, fails, or its RTDE watchdog,
+    /// a protective stop or the dashboard stops it ([`super::program`]).
     pub program: ProgramState,
-    /// The program's `rtde_set_watchdog` call, if it has one.
+    /// The text of the last program uploaded (`None`: the follow program, as `load X.urp` gives).
+    pub program_source: Option<String>,
+    /// The watchdog the running program set with `rtde_set_watchdog`, if any.
     pub watchdog: Option<RtdeWatchdog>,
     /// Programs uploaded so far (each upload restarts the program and its watchdog).
     pub program_uploads: u64,
+    /// The program's `textmsg`/`popup` lines and runtime errors, the latest
+    /// [`super::program::LOG_LINES`].
+    pub program_log: std::collections::VecDeque<String>,
     /// Why the arm is in a protective stop, if it is (cleared by `unlock protective stop` on the
     /// dashboard, or by a fresh program upload).
     pub protective_stop: Option<String>,
@@ -125,8 +131,10 @@ pub fn shared_state(
         outputs: RobotOutputs::default(),
         inputs: SharedInputs::new(),
         program: ProgramState::Stopped,
+        program_source: None,
         watchdog: None,
         program_uploads: 0,
+        program_log: std::collections::VecDeque::new(),
         protective_stop: None,
         ur: UrController::new(ur),
         bus,
@@ -193,6 +201,26 @@ pub fn open_bus(
     Ok((path, handle))
 }
 
+/// The arm RTDE reports at twin time `t` \[s\]: interpolated linearly between the physics states
+/// `before` and `after` (time \[s\], joints \[rad\]), `t` clamped to the span between them.
+///
+/// Why: the physics moves the arm once per step (5 ms), so reporting the latest step gave a 500 Hz
+/// client the same sample in two or three packages running. The kinematic arm moves at a constant
+/// rate within a step, so the interpolation is the arm's actual path. The physics steps once a
+/// tick's wait passes half of the step (`wait_until`), so the latest step ends within half a step
+/// of the twin's clock either way; at half a step behind the clock the sample is always between
+/// the last two steps: an interpolation, never an extrapolation. The cost: RTDE's samples are half a
+/// step (2.5 ms) older than before on average, and each is stamped with its own time.
+fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64, [f64; 6]) {
+    let span = after.0 - before.0;
+    if span <= 0.0 {
+        return (after.0, after.1);
+    }
+    let t = t.clamp(before.0, after.0);
+    let f = (t - before.0) / span;
+    (t, std::array::from_fn(|j| before.1[j] + (after.1[j] - before.1[j]) * f))
+}
+
 /// Runs the twin in real time on its own thread (the MuJoCo data stays on it).
 pub fn spawn(
     scenario: PickPlaceScenario,
@@ -225,14 +253,17 @@ pub fn spawn(
         // the last step's displacement over its duration (the kinematic arm moves at a constant
         // rate within a step), held until the next step changes them.
         let mut last_step = (first.time_s, first.arm_q, [first.growth_motor_rad, first.twine_motor_rad]);
+        // The arm at the step before: RTDE reports the arm interpolated between the two.
+        let mut step_before = (first.time_s, first.arm_q);
         let mut actual_qd = [0.0; ARM_JOINTS];
         // The motors' speeds, the same way (Present Velocity).
         let mut motor_rad_s = [0.0; 2];
         let mut measured_q = first.arm_q;
-        // The program's RTDE watchdog once armed: the watched input's write count and when it last
-        // changed (twin time, so a twin held up by a lock never counts as a silent client).
-        let mut watchdog: Option<(u64, f64)> = None;
-        let mut uploads_seen = 0;
+        // The virtual controller's program (the URScript interpreter).
+        let mut program = ProgramRunner::default();
+        // A generated trajectory's latest setpoint, its speed and time (see `ArmCommand::Track`).
+        let mut tracking: Option<([f64; 6], [f64; 6], f64)> = None;
+        let timestep_s = scenario.physics.timestep_s;
         {
             let mut s = lock(&state);
             for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
@@ -247,7 +278,6 @@ pub fn spawn(
             s.outputs.actual_tcp_pose = tcp_pose(&first.arm_q, &s.outputs.tcp_offset);
             s.outputs.target_tcp_pose = s.outputs.actual_tcp_pose;
         }
-        let mut packages_seen = 0;
         let started = Instant::now();
         for k in 1u64.. {
             if stop.load(Ordering::SeqCst) {
@@ -256,66 +286,40 @@ pub fn spawn(
             let now_s = (k - 1) as f64 * period_s;
             let new_arm_target = {
                 let mut s = lock(&state);
-                if s.program_uploads != uploads_seen {
-                    uploads_seen = s.program_uploads;
-                    watchdog = None;
+                // RTDEIOInterface and the like: the IO outputs each input package set.
+                for package in s.inputs.take_io_packages() {
+                    super::io::apply_io_package(&package, &mut s.outputs);
                 }
-                let enabled = s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
-                let targets: [f64; ARM_JOINTS] =
-                    std::array::from_fn(|j| s.inputs.values.double_registers[TARGET_REGISTER + j]);
-                // A target is new when a package came in: the arm then moves to it over the time
-                // since the one before, the client's cadence, as the simulated path's arm does.
-                let arrived = s.inputs.packages != packages_seen;
-                packages_seen = s.inputs.packages;
-                let mut hold = false;
-                // rtde_set_watchdog, as our program calls it: armed at the first enabled tick.
-                let watched =
-                    s.watchdog.as_ref().map(|w| (s.inputs.writes_of(&w.variable), w.min_frequency_hz, w.action));
-                if s.program == ProgramState::Playing
-                    && let Some((writes, min_hz, action)) = watched
+                let mut new = match program.tick(&mut s, now_s, measured_q) {
+                    ArmCommand::Keep => false,
+                    ArmCommand::Track { q, qd, at_s } => {
+                        tracking = Some((q, qd, at_s));
+                        false
+                    }
+                    ArmCommand::Move(q) => {
+                        tracking = None;
+                        command.arm_q = q;
+                        true
+                    }
+                    ArmCommand::Hold => {
+                        tracking = None;
+                        command.arm_q = measured_q;
+                        true
+                    }
+                };
+                // The physics steps in this tick's wait: command the trajectory's setpoint at the
+                // step's end (a step is due once the wait passes half of it, as `wait_until` runs).
+                let physics_s = last_step.0;
+                if let Some((q, qd, at_s)) = tracking
+                    && k as f64 * period_s - physics_s > 0.5 * timestep_s
                 {
-                    match &mut watchdog {
-                        None if enabled => watchdog = Some((writes, now_s)),
-                        None => {}
-                        Some((seen, at)) if *seen != writes => (*seen, *at) = (writes, now_s),
-                        Some((_, at)) if now_s - *at > 1.0 / min_hz => match action {
-                            WatchdogAction::Ignore => {}
-                            WatchdogAction::Pause | WatchdogAction::Stop => {
-                                s.program = if action == WatchdogAction::Stop {
-                                    ProgramState::Stopped
-                                } else {
-                                    ProgramState::Paused
-                                };
-                                hold = true;
-                            }
-                        },
-                        Some(_) => {}
-                    }
-                }
-                // Powered off or brakes engaged (dashboard): no program runs, the arm holds.
-                if s.ur.robot_mode != RobotMode::Running && s.program != ProgramState::Stopped {
-                    s.program = ProgramState::Stopped;
-                    hold = true;
-                }
-                let mut new = false;
-                if s.program == ProgramState::Playing && enabled && arrived {
-                    match super::safety::violation(&targets, &measured_q) {
-                        None => {
-                            command.arm_q = targets;
-                            new = true;
-                        }
-                        Some(why) => {
-                            // Protective stop: the arm stops where it is, the program stops.
-                            s.protective_stop = Some(why);
-                            s.ur.protective_stop_at = Some(now_s);
-                            s.program = ProgramState::Stopped;
-                            hold = true;
-                        }
-                    }
-                }
-                if hold {
-                    command.arm_q = measured_q;
+                    // Never more than a step and a cycle ahead of the program's last setpoint.
+                    let ahead = (physics_s + timestep_s - at_s).clamp(0.0, timestep_s + CONTROL_PERIOD_S);
+                    command.arm_q = std::array::from_fn(|j| q[j] + qd[j] * ahead);
                     new = true;
+                    if qd.iter().all(|v| *v == 0.0) {
+                        tracking = None;
+                    }
                 }
                 for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
                 {
@@ -340,16 +344,19 @@ pub fn spawn(
                 let dt = r.time_s - last_step.0;
                 actual_qd = std::array::from_fn(|j| (r.arm_q[j] - last_step.1[j]) / dt);
                 motor_rad_s = std::array::from_fn(|m| (motors_rad[m] - last_step.2[m]) / dt);
+                step_before = (last_step.0, last_step.1);
                 last_step = (r.time_s, r.arm_q, motors_rad);
             }
+            // What RTDE reports: the arm half a physics step behind the twin's clock, interpolated
+            // between the last two steps (see `rtde_sample`).
+            let (sample_s, sample_q) =
+                rtde_sample(step_before, (r.time_s, r.arm_q), k as f64 * period_s - 0.5 * timestep_s);
             // The load on each motor's output shaft: the tendon's tension on the twine spool; the
             // growth motor's load is not modelled (0).
             let motor_torque_nm = [0.0, cell.tendon_tension_n() * cell.twine_spool_radius_m()];
             measured_q = r.arm_q;
             {
                 let mut s = lock(&state);
-                let following =
-                    s.program == ProgramState::Playing && s.inputs.values.int_registers[ENABLE_REGISTER] == 1;
                 let runtime_state = match s.program {
                     ProgramState::Stopped => RUNTIME_STATE_STOPPED,
                     ProgramState::Playing => RUNTIME_STATE_PLAYING,
@@ -362,13 +369,12 @@ pub fn spawn(
                 o.runtime_state = runtime_state;
                 o.robot_mode = robot_mode;
                 o.safety_mode = safety_mode;
-                o.timestamp_s = r.time_s;
+                o.timestamp_s = sample_s;
                 o.actual_qd = actual_qd;
-                o.actual_q = r.arm_q;
+                o.actual_q = sample_q;
                 o.target_q = command.arm_q;
-                o.actual_tcp_pose = tcp_pose(&r.arm_q, &o.tcp_offset);
+                o.actual_tcp_pose = tcp_pose(&sample_q, &o.tcp_offset);
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
-                o.int_registers[FOLLOWING_REGISTER] = i32::from(following);
                 for (m, id) in motors.into_iter().enumerate() {
                     if let Some(t) = s.bus.table_mut(id) {
                         present_motion(t, r.time_s, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);
@@ -412,4 +418,20 @@ pub fn spawn(
         Ok(())
     };
     Ok(std::thread::Builder::new().name("twin".into()).spawn(run)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rtde_sample;
+
+    #[test]
+    fn rtde_samples_interpolate_between_the_last_two_steps_and_never_extrapolate() {
+        let (before, after) = ((0.010, [0.0; 6]), (0.015, [0.5; 6]));
+        let (t, q) = rtde_sample(before, after, 0.012);
+        assert_eq!(t, 0.012);
+        assert!((q[3] - 0.2).abs() < 1e-12, "{q:?}");
+        assert_eq!(rtde_sample(before, after, 0.020), (0.015, [0.5; 6]), "clamped to the latest step");
+        assert_eq!(rtde_sample(before, after, 0.001), (0.010, [0.0; 6]), "clamped to the step before");
+        assert_eq!(rtde_sample(after, after, 0.012), (0.015, [0.5; 6]), "no span: the latest step");
+    }
 }

@@ -198,6 +198,20 @@ pub fn input_type(name: &str) -> Option<RtdeType> {
         .or_else(|| register(name, "input").map(register_type))
 }
 
+/// Whether an input name sets an output of the controller's IO (digital and analog outputs and
+/// their masks, the speed slider) rather than a register.
+pub fn is_io_input(name: &str) -> bool {
+    [
+        "speed_slider_",
+        "standard_digital_output",
+        "configurable_digital_output",
+        "tool_digital_output",
+        "standard_analog_output_",
+    ]
+    .iter()
+    .any(|p| name.starts_with(p))
+}
+
 #[cfg(test)]
 /// The 58 names SDU's `ur_rtde` `RTDEReceiveInterface` asks for by default on PolyScope 5.11+.
 pub(crate) fn ur_rtde_default_outputs() -> Vec<String> {

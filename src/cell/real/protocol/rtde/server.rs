@@ -14,11 +14,11 @@
 use std::collections::HashMap;
 
 use super::RtdeError;
-use super::fields::{input_type, output_type};
+use super::fields::{input_type, is_io_input, output_type};
 use super::packet::{ClientPacket, ControllerVersion, MessageLevel, ServerPacket, TextMessage};
 use super::recipe::Recipe;
 use super::state::{OutputSource, RobotInputs, RobotOutputs};
-use super::types::FieldType;
+use super::types::{FieldType, RtdeValue};
 use crate::cell::real::protocol::Decoded;
 
 /// The only protocol version served.
@@ -53,7 +53,13 @@ pub struct SharedInputs {
     pub packages: u64,
     owners: HashMap<String, u64>,
     writes: HashMap<String, u64>,
+    /// The IO fields (digital and analog outputs, speed slider) of each package since the last
+    /// [`SharedInputs::take_io_packages`], oldest first, at most [`MAX_IO_PACKAGES`].
+    io_packages: Vec<Vec<(String, RtdeValue)>>,
 }
+
+/// IO packages kept for the device between its ticks (older ones are dropped).
+pub const MAX_IO_PACKAGES: usize = 1024;
 
 impl SharedInputs {
     /// Empty inputs, nothing claimed.
@@ -64,6 +70,12 @@ impl SharedInputs {
     /// How many input data packages wrote `name` so far (what `rtde_set_watchdog` watches).
     pub fn writes_of(&self, name: &str) -> u64 {
         self.writes.get(name).copied().unwrap_or(0)
+    }
+
+    /// The IO fields of each package received since the last call, oldest first: a mask and its
+    /// value apply once, per package, as the controller applies them.
+    pub fn take_io_packages(&mut self) -> Vec<Vec<(String, RtdeValue)>> {
+        std::mem::take(&mut self.io_packages)
     }
 
     /// Frees the inputs claimed by a closed connection.
@@ -237,6 +249,17 @@ impl ServerSession {
         let recipe =
             self.inputs.get(usize::from(recipe_id).wrapping_sub(1)).ok_or(RtdeError::UnknownRecipe(recipe_id))?;
         let values = recipe.decode(data)?;
+        // Applied whether or not the session was started: SDU ur_rtde's RTDEIOInterface sets up
+        // its input recipes and sends data packages without ever sending START, and works on real
+        // controllers, so they take inputs from a session that has not started.
+        let io: Vec<(String, RtdeValue)> =
+            recipe.names.iter().zip(&values).filter(|(n, _)| is_io_input(n)).map(|(n, v)| (n.clone(), *v)).collect();
+        if !io.is_empty() {
+            if shared.io_packages.len() >= MAX_IO_PACKAGES {
+                shared.io_packages.remove(0);
+            }
+            shared.io_packages.push(io);
+        }
         for (name, value) in recipe.names.iter().zip(values) {
             shared.values.apply(name, value);
             match shared.writes.get_mut(name) {

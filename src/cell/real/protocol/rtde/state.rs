@@ -60,6 +60,12 @@ pub struct RobotOutputs {
     pub double_registers: [f64; REGISTER_COUNT],
     /// `output_bit_register_0..127` as bits (0..63 are read as the two 32-bit words).
     pub bit_registers: u128,
+    /// `actual_digital_output_bits`: 0-7 standard, 8-15 configurable, 16-17 tool (RTDE guide).
+    pub digital_output_bits: u64,
+    /// `standard_analog_output0/1` \[A or V\].
+    pub standard_analog_output: [f64; 2],
+    /// `analog_io_types`: bits 0-1 inputs, 2-3 outputs 0 and 1; set = voltage, clear = current.
+    pub analog_io_types: u32,
 }
 
 impl Default for RobotOutputs {
@@ -83,6 +89,10 @@ impl Default for RobotOutputs {
             int_registers: [0; REGISTER_COUNT],
             double_registers: [0.0; REGISTER_COUNT],
             bit_registers: 0,
+            digital_output_bits: 0,
+            // Current mode at 0: 4 mA, the bottom of the 4-20 mA range.
+            standard_analog_output: [0.004; 2],
+            analog_io_types: 0,
         }
     }
 }
@@ -166,6 +176,10 @@ pub(crate) enum OutputSource {
     SpeedScaling,
     TargetSpeedFraction,
     RobotStatusBits,
+    DigitalOutputBits,
+    ConfigurableDigitalOutputBits,
+    StandardAnalogOutput(usize),
+    AnalogIoTypes,
     OutputRegister(Register),
     OutputBitWord(u32),
     InputRegister(Register),
@@ -200,6 +214,11 @@ impl OutputSource {
             "speed_scaling" => SpeedScaling,
             "target_speed_fraction" => TargetSpeedFraction,
             "robot_status_bits" => RobotStatusBits,
+            "actual_digital_output_bits" => DigitalOutputBits,
+            "actual_configurable_digital_output_bits" => ConfigurableDigitalOutputBits,
+            "standard_analog_output0" => StandardAnalogOutput(0),
+            "standard_analog_output1" => StandardAnalogOutput(1),
+            "analog_io_types" => AnalogIoTypes,
             "output_bit_registers0_to_31" => OutputBitWord(0),
             "output_bit_registers32_to_63" => OutputBitWord(1),
             "input_bit_registers0_to_31" => InputBitWord(0),
@@ -246,6 +265,10 @@ impl OutputSource {
                 let running = u32::from(out.runtime_state == RUNTIME_STATE_PLAYING);
                 V::Uint32(power | running << 1)
             }
+            DigitalOutputBits => V::Uint64(out.digital_output_bits),
+            ConfigurableDigitalOutputBits => V::Uint64(out.digital_output_bits >> 8 & 0xFF),
+            StandardAnalogOutput(i) => V::Double(out.standard_analog_output[i]),
+            AnalogIoTypes => V::Uint32(out.analog_io_types),
             OutputRegister(r) => register_value(r, &out.int_registers, &out.double_registers, out.bit_registers),
             OutputBitWord(w) => V::Uint32(word(out.bit_registers, w)),
             InputRegister(r) => register_value(r, &inp.int_registers, &inp.double_registers, inp.bit_registers),
