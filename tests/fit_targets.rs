@@ -40,6 +40,13 @@ fn a_fit_to_targets_writes_its_overlay_and_report() {
     assert!(overlay.contains("# lift only: \"object.friction\" = "), "{overlay}");
     let run = dir.path().join("run");
     let overlay = out.join("overlay.toml");
-    let o = tendril(&["run", "scenarios/short-lift.toml", "--overlay", overlay.to_str().unwrap(), "--out", run.to_str().unwrap()]);
+    let o = tendril(&[
+        "run",
+        "scenarios/short-lift.toml",
+        "--overlay",
+        overlay.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "the overlay does not apply: {}", stderr(&o));
 }

@@ -165,12 +165,16 @@ pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
             file,
             (
                 format!("parameters.\"{}\"", p.key),
-                format!("no target or recording is named `{}` (names: {})", p.scope().unwrap_or_default(), names.join(", ")),
+                format!(
+                    "no target or recording is named `{}` (names: {})",
+                    p.scope().unwrap_or_default(),
+                    names.join(", ")
+                ),
             ),
         )
         .into());
     }
-    for (name, path, table) in &runs {
+    for &(name, path, table) in &runs {
         let applying: Vec<Parameter> = params.iter().filter(|p| p.applies_to(name)).cloned().collect();
         super::space::check_bounds(file, &applying, &[(path, table)])?;
     }

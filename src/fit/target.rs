@@ -23,7 +23,12 @@
 //! outcome and the phase are steps; the drop time keeps the sum graded across them: a run that
 //! holds counts as dropping at its end (as the recordings' objective does), so a frozen grip that
 //! creeps too slowly to lose the object still scores by how far its end lies from the figure, and a
-//! run that should hold but drops scores by how early it dropped.
+//! run that should hold but drops scores by how early it dropped. Between the figures' steps
+//! the landscape can still be flat: a frozen grip that creeps too little holds to the end whatever
+//! the creep, so every such candidate scores alike and a search has no direction. So a run that
+//! should drop but holds also pays `miss_cost` times its lowest force reading while the arm moved,
+//! as a fraction of the setpoint: how close it came to letting go (the paper's reading "drops
+//! gradually, then to zero").
 
 use super::objective::PHASES;
 use crate::run::runner::RunReport;
@@ -114,6 +119,9 @@ pub struct RunFigures {
     pub rise_time_90_s: Option<f64>,
     /// Largest fluctuation while moving \[%\].
     pub max_fluctuation_pct: Option<f64>,
+    /// Lowest force reading while the arm moved with the object in the hand, in % of the
+    /// setpoint (None: the arm never moved with it).
+    pub lowest_force_pct: Option<f64>,
 }
 
 impl RunFigures {
@@ -126,6 +134,13 @@ impl RunFigures {
             end_s: report.cell_time_s - report.motion_start_s.unwrap_or(0.0),
             rise_time_90_s: s.metrics.rise_time_90_s,
             max_fluctuation_pct: s.metrics.max_fluctuation_pct,
+            lowest_force_pct: report
+                .rows
+                .iter()
+                .filter(|r| r.phase.arm_moving() && s.drop_cell_time_s.is_none_or(|d| r.time_s < d))
+                .filter(|r| r.setpoint_n > 0.0)
+                .map(|r| 100.0 * r.force_n / r.setpoint_n)
+                .reduce(f64::min),
         }
     }
 }
@@ -145,6 +160,8 @@ pub struct TargetResidual {
     pub rise_time_90_s: Option<f64>,
     /// The run's largest fluctuation while moving \[%\].
     pub max_fluctuation_pct: Option<f64>,
+    /// The run's lowest force reading while moving, in % of the setpoint.
+    pub lowest_force_pct: Option<f64>,
     /// Outcome and drop phase as the figures say.
     pub same_outcome: bool,
     /// This run's part of the objective (in tolerances).
@@ -226,6 +243,9 @@ impl TargetSpec {
         }
         if !same {
             score += self.miss_cost;
+            if expected == Some("dropped") && run.outcome == "held" {
+                score += self.miss_cost * run.lowest_force_pct.unwrap_or(100.0).max(0.0) / 100.0;
+            }
         }
         let drop_at = run.drop_time_s.unwrap_or(run.end_s);
         if let Some(t) = self.drop_time_s {
@@ -269,9 +289,10 @@ impl Target {
             .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.clone(), message: e.to_string() })?;
         table.insert("feedback".into(), toml::Value::Boolean(spec.feedback));
         let scenario: crate::run::scenario::PickPlaceScenario = crate::scenario::from_table(table.clone(), &file)?;
-        let name = spec.name.clone().unwrap_or_else(|| {
-            file.file_stem().map_or_else(|| "target".into(), |s| s.to_string_lossy().to_string())
-        });
+        let name = spec
+            .name
+            .clone()
+            .unwrap_or_else(|| file.file_stem().map_or_else(|| "target".into(), |s| s.to_string_lossy().to_string()));
         if name.is_empty() || name.contains(':') {
             return Err(invalid("name", format!("`{name}` must be non-empty and without `:`")));
         }
@@ -294,6 +315,7 @@ impl Target {
             drop_time_s: run.drop_time_s,
             rise_time_90_s: run.rise_time_90_s,
             max_fluctuation_pct: run.max_fluctuation_pct,
+            lowest_force_pct: run.lowest_force_pct,
             same_outcome,
             score,
         }
@@ -316,6 +338,7 @@ mod tests {
             end_s: 30.0,
             rise_time_90_s: Some(1.2),
             max_fluctuation_pct: None,
+            lowest_force_pct: Some(0.0),
         }
     }
 
@@ -327,6 +350,7 @@ mod tests {
             end_s: 30.0,
             rise_time_90_s: Some(1.2),
             max_fluctuation_pct: Some(fluctuation),
+            lowest_force_pct: Some(60.0),
         }
     }
 
@@ -347,9 +371,13 @@ mod tests {
         let near = s.score(&dropped("lift", 10.5), 15.0).0;
         let far = s.score(&dropped("lift", 12.0), 15.0).0;
         assert!((near - 0.5).abs() < 1e-12 && (far - 2.0).abs() < 1e-12, "{near} {far}");
-        // A run that holds counts as dropping at its end: wrong outcome plus 20 s late.
+        // A run that holds counts as dropping at its end: wrong outcome, 20 s late, and how much
+        // of its grip it kept (60 %); one that kept less came closer to the drop and costs less.
         let (h, same) = s.score(&held(10.0), 15.0);
-        assert!(!same && (h - 21.0).abs() < 1e-12, "{h}");
+        assert!(!same && (h - 21.6).abs() < 1e-12, "{h}");
+        let mut weaker = held(10.0);
+        weaker.lowest_force_pct = Some(20.0);
+        assert!((s.score(&weaker, 15.0).0 - 21.2).abs() < 1e-12);
         // A run that should hold but drops scores by how early.
         let k = spec("feedback = true\noutcome = \"held\"");
         assert!(k.score(&dropped("lift", 5.0), 15.0).0 > k.score(&dropped("lower", 25.0), 15.0).0);
