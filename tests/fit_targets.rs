@@ -1,4 +1,4 @@
-//! `tendril fit` against published figures (`[[targets]]`) instead of recordings: a two-evaluation
+//! `tendril fit` against published figures (`[[targets]]`) instead of recordings: a three-evaluation
 //! fit of the short lift writes its overlay (a scoped parameter as a comment) and a report whose
 //! objective and target residuals are those of real runs.
 
@@ -15,7 +15,7 @@ fn a_fit_to_targets_writes_its_overlay_and_report() {
          rise_time_max_s = 0.01\nrise_time_tol_s = 0.5\n\
          [parameters.\"lift:object.friction\"]\nmin = 0.6\nmax = 1.2\nstart = 0.85\n\
          [parameters.\"finger.relaxation_time_s\"]\nmin = 10.0\nmax = 20.0\nstart = 15.0\n\
-         [budget]\nevaluations = 2\npopulation = 2\n",
+         [budget]\nevaluations = 3\npopulation = 2\n",
         scenario.display()
     );
     std::fs::write(&spec, text).unwrap();
@@ -24,7 +24,8 @@ fn a_fit_to_targets_writes_its_overlay_and_report() {
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
-    assert_eq!(report["evaluations"], 2);
+    // The start, then one generation of two.
+    assert_eq!(report["evaluations"], 3);
     let objective = report["objective"].as_f64().unwrap();
     // The short lift holds and rises in about a second: a rise bound of 0.01 s must cost.
     assert!(objective.is_finite() && objective > 0.0 && objective < 100.0, "{report}");
