@@ -8,7 +8,8 @@ use std::process::ExitCode;
 /// Arguments of `tendril fit`.
 #[derive(Debug, clap::Args)]
 pub struct FitArgs {
-    /// The fit file (scenarios/fit/*.toml): recordings, parameters and bounds, weights, budget.
+    /// The fit file (scenarios/fit/*.toml): recordings and/or targets (published figures),
+    /// parameters and bounds, weights, budget.
     fit: PathBuf,
     /// Output folder: evaluations.jsonl, overlay.toml, fit.json, fit.png and fit.svg
     /// [default: out/fit-<fit file name>].
@@ -22,6 +23,10 @@ pub struct FitArgs {
     /// predictions).
     #[arg(long)]
     start: Option<PathBuf>,
+    /// Most evaluations, instead of the fit file's `budget.evaluations` (1 with `--start`: score
+    /// those values, e.g. a hand calibration, without searching).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    evaluations: Option<u64>,
     /// Continue the search logged in the output folder (evaluations already logged are not run
     /// again).
     #[arg(long)]
@@ -31,6 +36,9 @@ pub struct FitArgs {
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let mut fit = crate::fit::load_fit(&a.fit)?;
     fit.start_from(&crate::scenario::Overlay::load(a.start.as_deref())?)?;
+    if let Some(n) = a.evaluations {
+        fit.budget.evaluations = n as usize;
+    }
     let stem = a.fit.file_stem().map_or("fit".into(), |s| s.to_string_lossy().to_string());
     let out_dir = a.out.unwrap_or_else(|| PathBuf::from("out").join(format!("fit-{stem}")));
     crate::interrupt::install()?;
@@ -64,6 +72,19 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
             r.drop_time_error_s.map_or("-".into(), |v| format!("{v:+.2} s")),
             r.outcome,
             if r.same_outcome { " (as recorded)" } else { " (NOT as recorded)" },
+        );
+    }
+    for t in &report.targets {
+        text += &format!(
+            "  {:<28} {:<8} drop {:>7} in {:<9} rise {:>6}  fluctuation {:>7}  score {:.3}{}\n",
+            t.target,
+            t.outcome,
+            t.drop_time_s.map_or("-".into(), |v| format!("{v:.2} s")),
+            t.drop_phase.as_deref().unwrap_or("-"),
+            t.rise_time_90_s.map_or("-".into(), |v| format!("{v:.2} s")),
+            t.max_fluctuation_pct.map_or("-".into(), |v| format!("{v:.1} %")),
+            t.score,
+            if t.same_outcome { "" } else { " (NOT as the target says)" },
         );
     }
     text += &format!("wrote {}\n", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));

@@ -1,5 +1,6 @@
 //! Running a fit: each candidate re-runs every recording's effective scenario (its seed, its
-//! feedback mode) with the candidate's values, and is scored against the recordings; the best is
+//! feedback mode) and every target's scenario (its feedback mode, each of its seeds) with the
+//! candidate's values, and is scored against the recordings and the targets' figures; the best is
 //! written as an overlay, a report and a chart.
 
 use super::log::EvalLog;
@@ -7,6 +8,7 @@ use super::objective::{Residual, compare};
 use super::optimizer::{Evaluation, FAILED, SearchResult, minimize};
 use super::recording::{Events, Recording};
 use super::spec::Fit;
+use super::target::{Target, TargetResidual};
 use crate::run::execute::{ModelCache, run_on_twin};
 use crate::run::runner::RunReport;
 use crate::run::scenario::PickPlaceScenario;
@@ -29,11 +31,15 @@ pub fn simulate(base: &toml::Table, file: &Path, overrides: &[Override]) -> anyh
     run_on_twin(&scenario, &ModelCache::default(), None)
 }
 
+/// The overrides `values` make for the run named `name` (scoped parameters apply to their own).
+fn overrides_for(fit: &Fit, name: &str, values: &[f64]) -> Vec<Override> {
+    fit.params.iter().zip(values).filter(|(p, _)| p.applies_to(name)).map(|(p, &v)| p.override_at(v)).collect()
+}
+
 /// One recording re-run with `values` and compared with it; `None` rows when the run could not
 /// start.
 pub fn replay(fit: &Fit, r: &Recording, values: &[f64]) -> (Residual, Option<RunReport>) {
-    let overrides: Vec<Override> = fit.params.iter().zip(values).map(|(p, &v)| p.override_at(v)).collect();
-    match simulate(&r.table, &r.dir.join("summary.json"), &overrides) {
+    match simulate(&r.table, &r.dir.join("summary.json"), &overrides_for(fit, &r.name, values)) {
         Ok((summary, report)) => {
             let residual = compare(&r.name, &r.ticks, &r.events, &report.rows, &Events::of(&summary), &fit.weights);
             (residual, Some(report))
@@ -56,24 +62,106 @@ pub fn replay(fit: &Fit, r: &Recording, values: &[f64]) -> (Residual, Option<Run
     }
 }
 
-/// Scores a candidate: the mean of its recordings' scores; any run that fails makes it a failed
-/// candidate ([`FAILED`]), and the fit goes on.
-pub fn evaluate(fit: &Fit, values: &[f64]) -> Evaluation {
-    let residuals: Vec<Residual> = fit.recordings.par_iter().map(|r| replay(fit, r, values).0).collect();
-    let failed = residuals.iter().any(|r| r.outcome.starts_with("error"));
-    let objective =
-        if failed { FAILED } else { residuals.iter().map(|r| r.score).sum::<f64>() / residuals.len() as f64 };
-    Evaluation { objective, failed, detail: serde_json::json!({ "residuals": residuals }) }
+/// One target's run with `seed` and `values`, scored against its figures; `None` rows when the
+/// run could not start.
+pub fn replay_target(fit: &Fit, t: &Target, seed: u64, values: &[f64]) -> (TargetResidual, Option<RunReport>) {
+    let mut overrides = vec![Override { key: "seed".into(), value: toml::Value::Integer(seed as i64) }];
+    overrides.extend(overrides_for(fit, &t.name, values));
+    match simulate(&t.table, &t.file, &overrides) {
+        Ok((summary, report)) => (t.compare(seed, &summary, &report), Some(report)),
+        Err(e) => (
+            TargetResidual {
+                target: t.label(seed),
+                outcome: format!("error: {e:#}"),
+                score: FAILED,
+                ..TargetResidual::default()
+            },
+            None,
+        ),
+    }
 }
 
-/// The identity of a fit, for its log: a 64-bit FNV-1a hash of the parameters, weights and budget
-/// and of each recording's summary and trace.
+/// Every run of a candidate: the recordings' and the targets' (each seed), run in parallel.
+pub struct Replays {
+    /// Per recording.
+    pub recordings: Vec<(Residual, Option<RunReport>)>,
+    /// Per target and seed, in the fit file's order.
+    pub targets: Vec<(TargetResidual, Option<RunReport>)>,
+}
+
+impl Replays {
+    /// Runs them all with `values`.
+    pub fn run(fit: &Fit, values: &[f64]) -> Replays {
+        // One parallel loop over every run, so a slow recording does not idle a thread the
+        // targets could use.
+        enum Job<'a> {
+            Recording(&'a Recording),
+            Target(&'a Target, u64),
+        }
+        enum Done {
+            Recording((Residual, Option<RunReport>)),
+            Target((TargetResidual, Option<RunReport>)),
+        }
+        let jobs: Vec<Job> = fit
+            .recordings
+            .iter()
+            .map(Job::Recording)
+            .chain(fit.targets.iter().flat_map(|t| t.spec.seeds.iter().map(move |&s| Job::Target(t, s))))
+            .collect();
+        let done: Vec<Done> = jobs
+            .par_iter()
+            .map(|j| match j {
+                Job::Recording(r) => Done::Recording(replay(fit, r, values)),
+                Job::Target(t, seed) => Done::Target(replay_target(fit, t, *seed, values)),
+            })
+            .collect();
+        let mut out = Replays { recordings: Vec::new(), targets: Vec::new() };
+        for d in done {
+            match d {
+                Done::Recording(r) => out.recordings.push(r),
+                Done::Target(t) => out.targets.push(t),
+            }
+        }
+        out
+    }
+
+    /// Whether a run failed to start or run.
+    pub fn failed(&self) -> bool {
+        self.recordings.iter().any(|(r, _)| r.outcome.starts_with("error"))
+            || self.targets.iter().any(|(t, _)| t.outcome.starts_with("error"))
+    }
+
+    /// The mean of every run's score.
+    pub fn objective(&self) -> f64 {
+        let scores: Vec<f64> =
+            self.recordings.iter().map(|(r, _)| r.score).chain(self.targets.iter().map(|(t, _)| t.score)).collect();
+        scores.iter().sum::<f64>() / scores.len().max(1) as f64
+    }
+}
+
+/// Scores a candidate: the mean of its runs' scores (recordings and target seeds); any run that
+/// fails makes it a failed candidate ([`FAILED`]), and the fit goes on.
+pub fn evaluate(fit: &Fit, values: &[f64]) -> Evaluation {
+    let replays = Replays::run(fit, values);
+    let failed = replays.failed();
+    let objective = if failed { FAILED } else { replays.objective() };
+    let residuals: Vec<&Residual> = replays.recordings.iter().map(|(r, _)| r).collect();
+    let targets: Vec<&TargetResidual> = replays.targets.iter().map(|(t, _)| t).collect();
+    Evaluation { objective, failed, detail: serde_json::json!({ "residuals": residuals, "targets": targets }) }
+}
+
+/// The identity of a fit, for its log: a 64-bit FNV-1a hash of the parameters, weights and budget,
+/// of each target's figures and scenario, and of each recording's summary and trace.
 pub fn search_id(fit: &Fit) -> String {
     let mut parts: Vec<Vec<u8>> = vec![
         format!("{:?}", fit.params).into_bytes(),
         format!("{:?}", fit.weights).into_bytes(),
         format!("{:?}", fit.budget).into_bytes(),
     ];
+    for t in &fit.targets {
+        parts.push(format!("{:?}", t.spec).into_bytes());
+        parts.push(toml::to_string(&t.table).unwrap_or_default().into_bytes());
+    }
     for r in &fit.recordings {
         parts.push(std::fs::read(r.dir.join("summary.json")).unwrap_or_default());
         parts.push(format!("{:?}", r.ticks.len()).into_bytes());
@@ -121,6 +209,8 @@ pub struct FitReport {
     pub start_objective: Option<f64>,
     /// Each recording's residual at the best values.
     pub residuals: Vec<Residual>,
+    /// Each target run's residual at the best values.
+    pub targets: Vec<TargetResidual>,
     /// Evaluations used (including those taken from the log of an earlier session).
     pub evaluations: usize,
     /// Of those, evaluations taken from the log.
@@ -163,15 +253,18 @@ fn write_results(
 ) -> anyhow::Result<(FitReport, Vec<PathBuf>)> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
     // Stopped by a signal: the best candidate's residuals as logged (a replay would be cut short).
-    let replays: Vec<(Residual, Option<RunReport>)> = if crate::interrupt::requested().is_some() {
-        let logged: Vec<Residual> = result
-            .best_record
-            .as_ref()
-            .and_then(|r| serde_json::from_value(r.detail["residuals"].clone()).ok())
-            .unwrap_or_default();
-        logged.into_iter().map(|r| (r, None)).collect()
+    let replays = if crate::interrupt::requested().is_some() {
+        let logged = |key: &str| result.best_record.as_ref().map(|r| r.detail[key].clone());
+        let recordings: Vec<Residual> =
+            logged("residuals").and_then(|v| serde_json::from_value(v).ok()).unwrap_or_default();
+        let targets: Vec<TargetResidual> =
+            logged("targets").and_then(|v| serde_json::from_value(v).ok()).unwrap_or_default();
+        Replays {
+            recordings: recordings.into_iter().map(|r| (r, None)).collect(),
+            targets: targets.into_iter().map(|t| (t, None)).collect(),
+        }
     } else {
-        pool.install(|| fit.recordings.par_iter().map(|r| replay(fit, r, &result.best)).collect())
+        pool.install(|| Replays::run(fit, &result.best))
     };
     let objective = result.best_record.as_ref().and_then(|r| r.exact_objective()).unwrap_or(FAILED);
     let start: Vec<f64> = fit.params.iter().map(|p| p.start).collect();
@@ -190,7 +283,8 @@ fn write_results(
             .collect(),
         objective,
         start_objective,
-        residuals: replays.iter().map(|(r, _)| r.clone()).collect(),
+        residuals: replays.recordings.iter().map(|(r, _)| r.clone()).collect(),
+        targets: replays.targets.iter().map(|(t, _)| t.clone()).collect(),
         evaluations: result.history.len(),
         reused: result.reused,
         stop: result.stop.clone(),
@@ -213,19 +307,26 @@ fn write_results(
     super::write_text(&json, &(serde_json::to_string_pretty(&report)? + "\n"))?;
     written.push(json);
     let empty = (Residual::default(), None);
+    let fitted = |rep: &Option<RunReport>| {
+        rep.as_ref().map_or_else(Vec::new, |rep| rep.rows.iter().map(|t| (t.time_s, t.force_n)).collect())
+    };
     let chart = crate::plot::fit::FitChart {
         title: format!("tendril fit {}", fit.file.display()),
         traces: fit
             .recordings
             .iter()
-            .zip(replays.iter().chain(std::iter::repeat(&empty)))
+            .zip(replays.recordings.iter().chain(std::iter::repeat(&empty)))
             .map(|(r, (res, rep))| crate::plot::fit::TracePair {
                 name: format!("{} (RMSE {})", r.name, res.force_rmse_n.map_or("-".into(), |v| format!("{v:.3} N"))),
                 recorded: r.ticks.iter().map(|t| (t.time_s, t.force_n)).collect(),
-                fitted: rep
-                    .as_ref()
-                    .map_or_else(Vec::new, |rep| rep.rows.iter().map(|t| (t.time_s, t.force_n)).collect()),
+                fitted: fitted(rep),
             })
+            // A target has figures, not a trace: its panel shows the fitted run alone.
+            .chain(replays.targets.iter().map(|(t, rep)| crate::plot::fit::TracePair {
+                name: format!("{} ({}, score {:.3})", t.target, t.outcome, t.score),
+                recorded: Vec::new(),
+                fitted: fitted(rep),
+            }))
             .collect(),
         objective: result.history.iter().map(|r| (r.index, r.exact_objective().unwrap_or(FAILED), r.failed)).collect(),
     };

@@ -103,9 +103,26 @@ impl Parameter {
         if self.integer { toml::Value::Integer(v.round() as i64) } else { toml::Value::Float(v) }
     }
 
-    /// The `--set` override that puts `v` at this key.
+    /// The `--set` override that puts `v` at this key (its scenario key, without a scope).
     pub fn override_at(&self, v: f64) -> crate::scenario::Override {
-        crate::scenario::Override { key: self.key.clone(), value: self.toml_value(v) }
+        crate::scenario::Override { key: self.scenario_key().into(), value: self.toml_value(v) }
+    }
+
+    /// The scope of a key written `NAME:KEY` (a fit's target or recording name), which the
+    /// parameter applies to alone; None for a key that applies to every run. Scenario keys hold no
+    /// `:`, so the first one separates the scope.
+    pub fn scope(&self) -> Option<&str> {
+        self.key.split_once(':').map(|(scope, _)| scope)
+    }
+
+    /// The scenario key, without the scope.
+    pub fn scenario_key(&self) -> &str {
+        self.key.split_once(':').map_or(&self.key, |(_, key)| key)
+    }
+
+    /// Whether the parameter applies to the run named `name` (unscoped ones apply to every run).
+    pub fn applies_to(&self, name: &str) -> bool {
+        self.scope().is_none_or(|scope| scope == name)
     }
 }
 
@@ -201,6 +218,16 @@ mod tests {
         assert!((q.from_unit(0.25) - 0.85).abs() < 1e-12);
         assert_eq!(q.from_unit(-3.0), 0.6);
         assert_eq!(q.from_unit(7.0), 1.6);
+    }
+
+    #[test]
+    fn a_scoped_key_applies_to_its_runs_alone() {
+        let p = Parameter::from_spec("hammer:object.friction", &spec(0.5, 1.5, Scale::Linear)).unwrap();
+        assert_eq!((p.scope(), p.scenario_key()), (Some("hammer"), "object.friction"));
+        assert!(p.applies_to("hammer") && !p.applies_to("crimper"));
+        assert_eq!(p.override_at(1.0).key, "object.friction");
+        let q = Parameter::from_spec("finger.relaxed_fraction", &spec(0.01, 0.5, Scale::Log)).unwrap();
+        assert!(q.scope().is_none() && q.applies_to("crimper") && q.applies_to("hammer"));
     }
 
     #[test]

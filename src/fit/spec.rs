@@ -3,11 +3,19 @@
 //!
 //! ```toml
 //! recordings = ["runs/crimper-off", "runs/crimper-on"]   # run folders, relative to this file
+//! [[targets]]            # published figures instead of (or beside) recordings: fit::target
+//! scenario = "../crimper.toml"
+//! feedback = false
+//! drop_phase = "lift"
+//! drop_time_s = 10.0
 //! [parameters."finger.relaxation_time_s"]
 //! min = 5.0
 //! max = 60.0
 //! scale = "log"          # or "linear" (the default)
 //! start = 15.0           # default: the middle of the range
+//! [parameters."crimper:object.friction"]   # NAME:KEY: only the runs of targets or recordings so named
+//! min = 0.6
+//! max = 1.6
 //! [objective]            # optional; these are the defaults
 //! force_rmse = 1.0       # [1/N]
 //! twine_motor = 2.0      # [1/rad]
@@ -21,12 +29,15 @@
 //! step = 0.3
 //! seed = 1
 //! ```
-//! Everything is checked before anything runs ([`load_fit`]).
+//! A fit needs recordings, targets, or both. The objective is the mean of every run's score: each
+//! recording's ([`super::objective`], in N) and each target seed's ([`super::target`], in
+//! tolerances). Everything is checked before anything runs ([`load_fit`]).
 
 use super::objective::Weights;
 use super::optimizer::Budget;
 use super::recording::Recording;
 use super::space::{Parameter, ParameterSpec};
+use super::target::{Target, TargetSpec};
 use crate::scenario::ScenarioError;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -37,7 +48,11 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 pub struct FitFile {
     /// Run folders, relative to the fit file.
+    #[serde(default)]
     pub recordings: Vec<PathBuf>,
+    /// Published figures to match.
+    #[serde(default)]
+    pub targets: Vec<TargetSpec>,
     /// Scenario key → bounds.
     pub parameters: BTreeMap<String, ParameterSpec>,
     /// Weights of the objective's terms.
@@ -55,6 +70,8 @@ pub struct Fit {
     pub file: PathBuf,
     /// The recordings, read and checked.
     pub recordings: Vec<Recording>,
+    /// The targets, read and checked.
+    pub targets: Vec<Target>,
     /// The parameters, in key order.
     pub params: Vec<Parameter>,
     /// The objective's weights.
@@ -99,12 +116,18 @@ pub fn invalid(file: &Path, (key, reason): (String, String)) -> ScenarioError {
     ScenarioError::Invalid { file: file.into(), key, reason }
 }
 
-/// Reads and checks a fit file: every recording read and matched, every parameter a scenario key
-/// whose bounds are valid values in every recording's scenario, the weights and budget sane.
+/// Reads and checks a fit file: every recording read and matched, every target's scenario read
+/// and its figures checked, every parameter a scenario key whose bounds are valid values in every
+/// scenario it applies to (a scoped one's scope a target's or recording's name), the weights and
+/// budget sane.
 pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
     let spec: FitFile = read_spec(file)?;
-    if spec.recordings.is_empty() {
-        return Err(invalid(file, ("recordings".into(), "lists no recording".into())).into());
+    if spec.recordings.is_empty() && spec.targets.is_empty() {
+        return Err(invalid(
+            file,
+            ("recordings".into(), "lists no recording, and there is no [[targets]] entry: nothing to fit".into()),
+        )
+        .into());
     }
     if let Some(bad) = spec.objective.check() {
         return Err(invalid(file, bad).into());
@@ -122,11 +145,40 @@ pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
             Recording::read(&base.join(dir)).map_err(|source| SpecError::Recording { file: file.into(), index, source })
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let targets = spec
+        .targets
+        .iter()
+        .enumerate()
+        .map(|(index, t)| Target::load(file, base, index, t))
+        .collect::<Result<Vec<_>, _>>()?;
+    // Every run the fit makes: (name, where its scenario came from, the scenario).
     let summaries: Vec<PathBuf> = recordings.iter().map(|r| r.dir.join("summary.json")).collect();
-    let scenarios: Vec<(&Path, &toml::Table)> =
-        summaries.iter().zip(&recordings).map(|(f, r)| (f.as_path(), &r.table)).collect();
-    super::space::check_bounds(file, &params, &scenarios)?;
-    Ok(Fit { file: file.into(), recordings, params, weights: spec.objective, budget: spec.budget })
+    let runs: Vec<(&str, &Path, &toml::Table)> = recordings
+        .iter()
+        .zip(&summaries)
+        .map(|(r, f)| (r.name.as_str(), f.as_path(), &r.table))
+        .chain(targets.iter().map(|t| (t.name.as_str(), t.file.as_path(), &t.table)))
+        .collect();
+    if let Some(p) = params.iter().find(|p| p.scope().is_some_and(|s| !runs.iter().any(|r| r.0 == s))) {
+        let names: Vec<&str> = runs.iter().map(|r| r.0).collect();
+        return Err(invalid(
+            file,
+            (
+                format!("parameters.\"{}\"", p.key),
+                format!(
+                    "no target or recording is named `{}` (names: {})",
+                    p.scope().unwrap_or_default(),
+                    names.join(", ")
+                ),
+            ),
+        )
+        .into());
+    }
+    for &(name, path, table) in &runs {
+        let applying: Vec<Parameter> = params.iter().filter(|p| p.applies_to(name)).cloned().collect();
+        super::space::check_bounds(file, &applying, &[(path, table)])?;
+    }
+    Ok(Fit { file: file.into(), recordings, targets, params, weights: spec.objective, budget: spec.budget })
 }
 
 impl Fit {
@@ -152,5 +204,62 @@ impl Fit {
             p.start = v;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fit file in a fresh folder whose targets name the repository's short lift.
+    fn fit_with(text: &str) -> (tempfile::TempDir, PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/short-lift.toml");
+        std::fs::copy(scenario, dir.path().join("short-lift.toml")).unwrap();
+        let file = dir.path().join("fit.toml");
+        std::fs::write(&file, text).unwrap();
+        (dir, file)
+    }
+
+    const GOOD: &str = "[[targets]]\nscenario = \"short-lift.toml\"\nfeedback = false\noutcome = \"held\"\n\
+        [[targets]]\nscenario = \"short-lift.toml\"\nname = \"other\"\nfeedback = true\nseeds = [1, 2]\n\
+        max_fluctuation_pct = 20.0\n\
+        [parameters.\"short-lift:object.friction\"]\nmin = 0.5\nmax = 1.5\n\
+        [parameters.\"finger.relaxed_fraction\"]\nmin = 0.01\nmax = 0.5\n";
+
+    /// The error `text` gives, as a message.
+    fn error(text: &str) -> String {
+        let (_dir, file) = fit_with(text);
+        load_fit(&file).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_fit_of_targets_alone_loads_with_its_names_modes_and_seeds() {
+        let (_dir, file) = fit_with(GOOD);
+        let fit = load_fit(&file).unwrap();
+        assert!(fit.recordings.is_empty());
+        let names: Vec<(&str, bool, &[u64])> =
+            fit.targets.iter().map(|t| (t.name.as_str(), t.spec.feedback, t.spec.seeds.as_slice())).collect();
+        assert_eq!(names, [("short-lift", false, &[1][..]), ("other", true, &[1, 2][..])]);
+        assert_eq!(fit.targets[0].table["feedback"], toml::Value::Boolean(false));
+        assert_eq!(fit.targets[0].grasp_s, 3.0);
+        let scoped: Vec<Option<&str>> = fit.params.iter().map(|p| p.scope()).collect();
+        assert_eq!(scoped, [None, Some("short-lift")]);
+    }
+
+    #[test]
+    fn bad_targets_are_named_with_the_file_and_key() {
+        let e = error(&GOOD.replace("outcome = \"held\"", "outcome = \"held\"\nwobble = 1"));
+        assert!(e.contains("fit.toml") && e.contains("targets[0]") && e.contains("wobble"), "{e}");
+        let e = error(&GOOD.replace("outcome = \"held\"", "drop_phase = \"liftt\""));
+        assert!(e.contains("targets[0].drop_phase") && e.contains("liftt"), "{e}");
+        let e = error(&GOOD.replacen("scenario = \"short-lift.toml\"", "scenario = \"nowhere.toml\"", 1));
+        assert!(e.contains("fit.toml") && e.contains("targets[0].scenario") && e.contains("nowhere.toml"), "{e}");
+        let e = error(&GOOD.replace("short-lift:object", "shortlift:object"));
+        assert!(e.contains("parameters.\"shortlift:object.friction\"") && e.contains("no target"), "{e}");
+        let e = error(&GOOD.replace("short-lift:object.friction", "short-lift:object.frction"));
+        assert!(e.contains("not a scenario key"), "{e}");
+        let e = error("[parameters.\"finger.relaxed_fraction\"]\nmin = 0.01\nmax = 0.5\n");
+        assert!(e.contains("recordings") && e.contains("no [[targets]]"), "{e}");
     }
 }

@@ -203,6 +203,15 @@ pub fn load_tune(file: &Path, overlay: &Overlay) -> Result<Tune, ScenarioError> 
         }
     }
     let params = super::space::parameters(file, &spec.parameters)?;
+    if let Some(p) = params.iter().find(|p| p.scope().is_some()) {
+        return Err(invalid(
+            file,
+            (
+                format!("parameters.\"{}\"", p.key),
+                "a scoped key (NAME:KEY) is a fit's; a tune searches each scenario on its own".into(),
+            ),
+        ));
+    }
     let base = file.parent().unwrap_or(Path::new(""));
     let mut scenarios = Vec::new();
     for path in &spec.scenarios {

@@ -71,8 +71,10 @@ impl Chart for FitChart {
             let all = pair.recorded.iter().chain(&pair.fitted);
             let (t0, t1) = span(all.clone().map(|p| p.0));
             // Impacts after a drop spike to the sensor's range: the axis follows the bulk of the
-            // recording, and what goes beyond is drawn at the edge.
-            let (f0, f1) = robust_span(pair.recorded.iter().map(|p| p.1));
+            // recording (of the fitted run when there is none: a fit target), and what goes beyond
+            // is drawn at the edge.
+            let basis = if pair.recorded.is_empty() { &pair.fitted } else { &pair.recorded };
+            let (f0, f1) = robust_span(basis.iter().map(|p| p.1));
             let clip = move |&(t, f): &(f64, f64)| (t, f.clamp(f0, f1));
             let mut c = ChartBuilder::on(area)
                 .caption(&pair.name, (FONT, style::CAPTION))
