@@ -11,7 +11,10 @@
 //!
 //! The program (`urscript/follow.script`, written by this project) loops forever:
 //! - `input_int_register_24` = 1: read the six joint targets from `input_double_register_24..29`
-//!   \[rad\] and `servoj` to them over 2 ms (one RTDE period at 500 Hz), `output_int_register_24` = 1;
+//!   \[rad\] and `servoj` towards them every 2 ms controller cycle, `output_int_register_24` = 1.
+//!   A new target is reached in even steps over as many cycles as the one before took to arrive
+//!   (the client's tick, about 5 cycles), so `servoj` sees a new setpoint every cycle rather than a
+//!   step every fifth one; the cost is one client tick of lag;
 //! - anything else: `stopj(2.0)` (2 rad/s² deceleration), `output_int_register_24` = 0.
 //!
 //! From the first enabled target on, `rtde_set_watchdog("input_int_register_24", 2, "stop")`

@@ -123,6 +123,29 @@ fn the_follow_script_follows_the_registers_while_enabled_and_arms_a_2_hz_stop_wa
 }
 
 #[test]
+fn the_follow_script_spreads_each_new_target_over_the_cycles_the_last_one_took() {
+    let mut fake = Fake::new();
+    let mut p = Interpreter::new(FOLLOW_SCRIPT, [0.0; 6]).unwrap();
+    fake.in_int[ENABLE_REGISTER] = 1;
+    fake.in_float[TARGET_REGISTER] = 0.1;
+    fake.packages = 1;
+    let first = run(&mut p, &mut fake, 0, 5);
+    assert_eq!(first.len(), 1, "the first target at once: {first:?}");
+    assert_eq!(first[0].1[0], 0.1);
+    // The next target 5 cycles later (a 100 Hz client against the 500 Hz controller): one
+    // evenly spaced setpoint per cycle, reaching it after 5 cycles, then held.
+    fake.in_float[TARGET_REGISTER] = 0.2;
+    fake.packages = 2;
+    let spread = run(&mut p, &mut fake, 5, 8);
+    let joint0: Vec<f64> = spread.iter().map(|(_, q)| q[0]).collect();
+    assert_eq!(joint0.len(), 5, "a setpoint per cycle until the target: {spread:?}");
+    for (i, q) in joint0.iter().enumerate() {
+        let want = 0.1 + 0.1 * (i + 1) as f64 / 5.0;
+        assert!((q - want).abs() < 1e-12, "cycle {i}: {q} against {want}");
+    }
+}
+
+#[test]
 fn movej_blocks_the_program_until_the_arm_is_there() {
     let mut fake = Fake::new();
     let src = program("  movej([0.1, 0, 0, 0, 0, -0.1], a=2, v=1)\n  write_output_integer_register(0, 7)\n");
