@@ -30,8 +30,9 @@ pub fn short_lift(overrides: &[&str]) -> PickPlaceScenario {
 /// Watchdog [s] for the real-time tests that do not test the watchdog: a shared virtual machine
 /// sometimes does not run a process for tens of milliseconds (60 ms seen), and with both cores
 /// busy a reply over the virtual bus's pty took over 50 ms; a run's watchdogs (5 ms, 10 ms, 50 ms)
-/// would rightly stop on either. These tests are about agreement, not timing.
-pub const LOOSE_WATCHDOG_S: f64 = 0.25;
+/// would rightly stop on either, and under a parallel build a motor reply was once 250 ms late.
+/// These tests are about agreement, not timing. Below the follow program's 0.5 s RTDE watchdog.
+pub const LOOSE_WATCHDOG_S: f64 = 0.4;
 
 /// Loosens `config`'s watchdogs and the motors' reply timeout to [`LOOSE_WATCHDOG_S`].
 pub fn loose_watchdog(config: &mut tendril::cell::real::RealCellConfig) {
