@@ -121,10 +121,12 @@ impl ProgramRunner {
     /// or ends the program and returns what the arm should do.
     pub fn tick(&mut self, s: &mut DeviceState, now_s: f64, measured_q: [f64; 6]) -> ArmCommand {
         let mut hold = false;
+        // A new upload replaces the running program. The script port set it playing when it
+        // arrived; a dashboard `pause`, `stop` or `power off` since then stands (setting it
+        // playing here again, a tick late, restarted programs the dashboard had stopped).
         if s.program_uploads != self.uploads_seen {
             self.uploads_seen = s.program_uploads;
             self.end(s);
-            s.program = ProgramState::Playing;
         }
         // Powered off or brakes engaged (dashboard): no program runs, the arm holds.
         if s.ur.robot_mode != RobotMode::Running && s.program != ProgramState::Stopped {
@@ -248,5 +250,47 @@ impl ProgramRunner {
                 true
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::fbg::SpectralConfig;
+    use crate::cell::real::HardwareConfig;
+    use crate::cell::real::serve::dashboard::VirtualUrSetup;
+
+    /// What `serve_script` does when a complete program arrives.
+    fn upload(s: &mut DeviceState) {
+        s.program_source = Some(FOLLOW_SCRIPT.to_string());
+        s.program_uploads += 1;
+        s.program = ProgramState::Playing;
+    }
+
+    #[test]
+    fn a_dashboard_stop_before_the_twin_sees_an_upload_stands() {
+        let (state, _) = super::super::twin::shared_state(
+            &HardwareConfig::default(),
+            &SpectralConfig::default(),
+            &VirtualUrSetup::default(),
+        )
+        .unwrap();
+        let mut s = state.lock().unwrap();
+        let mut runner = ProgramRunner::default();
+        upload(&mut s);
+        // The dashboard stops it before the twin's next tick (a delayed twin thread).
+        s.program = ProgramState::Stopped;
+        runner.tick(&mut s, 0.0, [0.0; 6]);
+        assert_eq!(s.program, ProgramState::Stopped, "the stop stands");
+        // Played again, it runs the uploaded program.
+        s.program = ProgramState::Playing;
+        runner.tick(&mut s, 0.002, [0.0; 6]);
+        assert_eq!(s.program, ProgramState::Playing);
+        assert!(runner.interpreter.is_some(), "the program started");
+        // A second upload replaces it and plays.
+        upload(&mut s);
+        runner.tick(&mut s, 0.004, [0.0; 6]);
+        assert_eq!(s.program, ProgramState::Playing);
+        assert_eq!(runner.uploads_seen, 2);
     }
 }
