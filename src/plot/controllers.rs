@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The columns of `controllers.csv`, in order.
-pub const COLUMNS: [&str; 14] = [
+pub const COLUMNS: [&str; 15] = [
     "controller",
     "object",
     "disturbance",
@@ -23,6 +23,7 @@ pub const COLUMNS: [&str; 14] = [
     "rise_time_s",
     "overshoot_pct",
     "max_fluctuation_pct",
+    "fluctuation_outside_push_pct",
     "peak_force_n",
     "drop_detection_delay_s",
     "false_alarms",
@@ -52,6 +53,10 @@ pub struct ControllerRow {
     pub overshoot_pct: Option<f64>,
     /// Largest |F − setpoint| / setpoint while the arm moves \[%\] (None unless held).
     pub fluctuation_pct: Option<f64>,
+    /// The same, leaving out a push's impact and the object set down early
+    /// ([`crate::run::metrics::fluctuation_outside_push_pct`]) \[%\]; equal to `fluctuation_pct`
+    /// without a push.
+    pub fluctuation_outside_push_pct: Option<f64>,
     /// Largest (despiked) estimate while holding \[N\].
     pub peak_force_n: Option<f64>,
     /// From the true drop to the slip detector's drop alarm \[s\] (None: no drop, or not seen).
@@ -62,7 +67,8 @@ pub struct ControllerRow {
     pub error: Option<String>,
 }
 
-/// Reads `controllers.csv` (the [`COLUMNS`]; `error` and the detector's columns may be absent).
+/// Reads `controllers.csv` (the [`COLUMNS`]; `error`, the detector's columns and
+/// `fluctuation_outside_push_pct` may be absent: files of earlier versions).
 pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
     let t = Table::read(path)?;
     let col = |name: &str| t.column(name);
@@ -73,6 +79,7 @@ pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
         (col("rise_time_s")?, col("overshoot_pct")?, col("max_fluctuation_pct")?, col("peak_force_n")?);
     let error = t.optional_column("error");
     let (delay, false_alarms) = (t.optional_column("drop_detection_delay_s"), t.optional_column("false_alarms"));
+    let outside_push = t.optional_column("fluctuation_outside_push_pct");
     let rows = t
         .iter()
         .map(|r| {
@@ -92,6 +99,10 @@ pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
                 rise_time_s: r.opt_f64(rise)?,
                 overshoot_pct: r.opt_f64(overshoot)?,
                 fluctuation_pct: r.opt_f64(fluctuation)?,
+                fluctuation_outside_push_pct: match outside_push {
+                    Some(c) => r.opt_f64(c)?,
+                    None => r.opt_f64(fluctuation)?,
+                },
                 peak_force_n: r.opt_f64(peak)?,
                 drop_detection_delay_s: match delay {
                     Some(c) => r.opt_f64(c)?,

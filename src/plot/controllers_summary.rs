@@ -32,6 +32,10 @@ pub struct SummaryRow {
     pub fluctuation_mean_pct: Option<f64>,
     /// Largest over the held runs of the largest fluctuation while moving \[%\].
     pub fluctuation_worst_pct: Option<f64>,
+    /// Mean over the held runs of the fluctuation outside a push's impact \[%\].
+    pub outside_push_mean_pct: Option<f64>,
+    /// Largest over the held runs of the fluctuation outside a push's impact \[%\].
+    pub outside_push_worst_pct: Option<f64>,
     /// Mean rise time over the runs that rose \[s\].
     pub rise_mean_s: Option<f64>,
     /// Longest rise time \[s\].
@@ -74,10 +78,12 @@ pub fn aggregate(rows: &[ControllerRow]) -> Vec<SummaryRow> {
                 .collect();
             let held: Vec<&&ControllerRow> = group.iter().filter(|r| r.outcome == "held").collect();
             let fluctuation: Vec<f64> = held.iter().filter_map(|r| r.fluctuation_pct).collect();
+            let outside_push: Vec<f64> = held.iter().filter_map(|r| r.fluctuation_outside_push_pct).collect();
             let rise: Vec<f64> = group.iter().filter_map(|r| r.rise_time_s).collect();
             let overshoot: Vec<f64> = group.iter().filter_map(|r| r.overshoot_pct).collect();
             let peak: Vec<f64> = group.iter().filter_map(|r| r.peak_force_n).collect();
             let (fluctuation_mean_pct, fluctuation_worst_pct) = mean_max(&fluctuation);
+            let (outside_push_mean_pct, outside_push_worst_pct) = mean_max(&outside_push);
             let (rise_mean_s, rise_worst_s) = mean_max(&rise);
             let (overshoot_mean_pct, overshoot_worst_pct) = mean_max(&overshoot);
             let (peak_force_mean_n, peak_force_worst_n) = mean_max(&peak);
@@ -98,6 +104,8 @@ pub fn aggregate(rows: &[ControllerRow]) -> Vec<SummaryRow> {
                 held_rate: if group.is_empty() { 0.0 } else { held.len() as f64 / group.len() as f64 },
                 fluctuation_mean_pct,
                 fluctuation_worst_pct,
+                outside_push_mean_pct,
+                outside_push_worst_pct,
                 rise_mean_s,
                 rise_worst_s,
                 overshoot_mean_pct,
@@ -133,13 +141,14 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 /// The table as markdown, one line per row.
 pub fn markdown(rows: &[SummaryRow]) -> String {
     let mut s = String::from(
-        "| object | disturbance | controller | held | fluctuation while moving, mean / worst [%] | rise, mean [s] | \
+        "| object | disturbance | controller | held | fluctuation while moving, mean / worst [%] | \
+         the same outside a knock's impact, mean / worst [%] | rise, mean [s] | \
          overshoot, mean / worst [%] | peak force, mean / worst [N] | drops seen ≤ 0.3 s | false alarms |\n\
-         | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+         | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {} | {} | {}/{} | {} / {} | {} | {} / {} | {} / {} | {} | {} |\n",
+            "| {} | {} | {} | {}/{} | {} / {} | {} / {} | {} | {} / {} | {} / {} | {} | {} |\n",
             r.object,
             r.disturbance,
             r.controller,
@@ -147,6 +156,8 @@ pub fn markdown(rows: &[SummaryRow]) -> String {
             r.runs,
             fmt(r.fluctuation_mean_pct, 0),
             fmt(r.fluctuation_worst_pct, 0),
+            fmt(r.outside_push_mean_pct, 0),
+            fmt(r.outside_push_worst_pct, 0),
             fmt(r.rise_mean_s, 2),
             fmt(r.overshoot_mean_pct, 0),
             fmt(r.overshoot_worst_pct, 0),
@@ -175,6 +186,7 @@ mod tests {
             rise_time_s: Some(peak),
             overshoot_pct: Some(10.0 * peak),
             fluctuation_pct: fluctuation,
+            fluctuation_outside_push_pct: fluctuation.map(|f| f / 2.0),
             peak_force_n: Some(peak),
             // A drop seen 0.1 s after it; a held run with one false alarm.
             drop_detection_delay_s: (outcome == "dropped").then_some(0.1),
@@ -200,6 +212,7 @@ mod tests {
         // The error's 99 % is not a held run's: it must not count.
         assert_eq!(pid.fluctuation_mean_pct, Some(10.0));
         assert_eq!(pid.fluctuation_worst_pct, Some(12.0));
+        assert_eq!((pid.outside_push_mean_pct, pid.outside_push_worst_pct), (Some(5.0), Some(6.0)));
         assert_eq!(pid.peak_force_worst_n, Some(3.0));
         assert_eq!(pid.peak_force_mean_n, Some(6.5 / 4.0));
         assert_eq!(pid.overshoot_worst_pct, Some(30.0));
@@ -227,6 +240,6 @@ mod tests {
         let s = aggregate(&[run("pid", "crimper", "dropped", None, 1.0)]);
         let md = markdown(&s);
         assert_eq!(md.lines().count(), 3);
-        assert!(md.contains("| crimper | knock | pid | 0/1 | - / - | 1.00 | 10 / 10 | 1.00 / 1.00 |"), "{md}");
+        assert!(md.contains("| crimper | knock | pid | 0/1 | - / - | - / - | 1.00 | 10 / 10 | 1.00 / 1.00 |"), "{md}");
     }
 }

@@ -81,7 +81,12 @@ pub fn run_on_cell(
         }
         None => None,
     };
-    let report = run_task(cell, &scenario.control_plan(), trace.as_mut());
+    let mut report = run_task(cell, &scenario.control_plan(), trace.as_mut());
+    if let Some(push) = &scenario.disturbance.push {
+        let drop_time_s = report.drop.map(|d| d.cell_time_s);
+        report.metrics.max_fluctuation_outside_push_pct =
+            super::metrics::fluctuation_outside_push_pct(&report.rows, drop_time_s, push);
+    }
     let mut summary =
         RunSummary::new(scenario.identity(cell.backend()), &report, started.wall_s(), started.thread_cpu_s());
     // The run's own thread stepped its physics (and compiled its model, if not cached).

@@ -1,6 +1,7 @@
 //! The figures the paper reports for a pick-and-place run, computed from the tick records.
 
 use super::trace::TraceRow;
+use crate::cell::disturbance::PushConfig;
 use crate::control::task::Phase;
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +16,12 @@ pub struct ControlMetrics {
     pub overshoot_pct: f64,
     /// Largest |F − setpoint| / setpoint while the arm moves [%] (None when nothing was held).
     pub max_fluctuation_pct: Option<f64>,
+    /// As `max_fluctuation_pct`, leaving out a push on the object (`[disturbance.push]`), the
+    /// [`PUSH_IMPACT_S`] after it and the object set down on the table early
+    /// ([`SET_DOWN_HEIGHT_M`]) [%]: how well the grip holds the setpoint once the knock's impact
+    /// has passed through the pad. Equal to `max_fluctuation_pct` without a push.
+    #[serde(default)]
+    pub max_fluctuation_outside_push_pct: Option<f64>,
     /// Smallest estimate while the arm moves \[N\].
     pub min_moving_force_n: Option<f64>,
     /// RMS of estimate − true force from the grasp to the release \[N\] (None without ground truth).
@@ -79,6 +86,47 @@ fn despiked_force(rows: &[&TraceRow]) -> Vec<f64> {
         .collect()
 }
 
+/// What [`ControlMetrics::max_fluctuation_outside_push_pct`] leaves out after a push ends \[s\].
+/// A stated choice, from the knocked hammer's trace (PID, seed 1, 0.3 N·s over 20 ms 1 s into the
+/// transfer, the arm at the paper's limits): the impact rings through the wrap for about 0.7 s
+/// (the pad reads 1.0-3.4 N on a 1.6 N setpoint), then the estimate stays in the band the
+/// controller works in (1.2-1.5 N, the hammer re-seated lower in the grip). Leaving out 0.5 /
+/// 0.75 / 1.0 / 1.5 / 2.0 s gives 37 / 25 / 20.4 / 20.4 / 20.4 %: from 1 s on the figure is the
+/// controller's answer to the changed grip, which the metric is meant to show.
+pub const PUSH_IMPACT_S: f64 = 1.0;
+
+/// Height above its resting place on the table below which an object counts as set down \[m\]
+/// (2 mm: resting, or touching down within a tick at the lowering's speed). A knocked object
+/// slides down the grip (the hammer by 18 mm) and the lowering, planned for the object where it
+/// was, then sets it on the table early: the table pushes it into the pad (the hammer's estimate
+/// 4.6 N on a 1.6 N setpoint, 190 %). That reading is the table's, not the grip's.
+pub const SET_DOWN_HEIGHT_M: f64 = 0.002;
+
+/// Largest |F − setpoint| / setpoint \[%\] over the ticks the arm moves and `counts` accepts;
+/// `None` when the object was dropped (`drop_time_s`) or no such tick exists.
+pub fn max_fluctuation_pct(
+    rows: &[TraceRow],
+    drop_time_s: Option<f64>,
+    counts: impl Fn(&TraceRow) -> bool,
+) -> Option<f64> {
+    let moving: Vec<&TraceRow> = rows.iter().filter(|r| r.phase.arm_moving() && counts(r)).collect();
+    (drop_time_s.is_none() && !moving.is_empty())
+        .then(|| moving.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n).abs() / r.setpoint_n).fold(0.0, f64::max))
+}
+
+/// [`ControlMetrics::max_fluctuation_outside_push_pct`] for a run pushed by `push`: the ticks from
+/// the push's onset (its time, or the first tick of its phase plus the offset) to
+/// [`PUSH_IMPACT_S`] after it ends are left out, and so are those with the object set down on the
+/// table ([`SET_DOWN_HEIGHT_M`]; known on the twin only: on the real cell they stay in). A push
+/// whose phase never came leaves out only the latter.
+pub fn fluctuation_outside_push_pct(rows: &[TraceRow], drop_time_s: Option<f64>, push: &PushConfig) -> Option<f64> {
+    let onset = push.onset().resolve(|phase| rows.iter().find(|r| r.phase == phase).map(|r| r.time_s));
+    let impact = onset.map(|t| (t, t + push.duration_s + PUSH_IMPACT_S));
+    let outside_impact = |r: &TraceRow| impact.is_none_or(|(from, to)| r.time_s < from || r.time_s >= to);
+    let set_down = |r: &TraceRow| r.object_height_m < SET_DOWN_HEIGHT_M;
+    max_fluctuation_pct(rows, drop_time_s, |r| outside_impact(r) && !set_down(r))
+}
+
 /// Computes [`ControlMetrics`] from a run's rows. `drop_time_s` bounds the moving window: ticks
 /// after a drop do not count as fluctuation.
 pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMetrics {
@@ -91,8 +139,7 @@ pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMe
         grasp.iter().zip(&despiked).map(|(r, f)| 100.0 * (f - r.setpoint_n) / r.setpoint_n).fold(0.0, f64::max);
     let moving: Vec<&TraceRow> =
         rows.iter().filter(|r| r.phase.arm_moving() && drop_time_s.is_none_or(|d| r.time_s < d)).collect();
-    let max_fluctuation_pct = (drop_time_s.is_none() && !moving.is_empty())
-        .then(|| moving.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n).abs() / r.setpoint_n).fold(0.0, f64::max));
+    let max_fluctuation_pct = max_fluctuation_pct(rows, drop_time_s, |_| true);
     let min_moving_force_n = moving.iter().map(|r| r.force_n).reduce(f64::min);
     let compared: Vec<f64> = rows
         .iter()
@@ -109,6 +156,8 @@ pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMe
         rise_time_90_s,
         overshoot_pct,
         max_fluctuation_pct,
+        // The rows do not say where a push was: `run_on_cell`, which knows the scenario, narrows it.
+        max_fluctuation_outside_push_pct: max_fluctuation_pct,
         min_moving_force_n,
         force_rmse_n,
         oscillating,
@@ -119,6 +168,38 @@ pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMe
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_fluctuation_outside_a_push_leaves_out_its_impact_and_no_more() {
+        // Transfer from 10 s, every 0.1 s: on the setpoint but for a spike of +200 % at 11.1 s
+        // (the push, 1 s into the transfer) and +30 % at 12.5 s (after the impact window).
+        let rows: Vec<TraceRow> = (0..40)
+            .map(|k| {
+                let t = 10.0 + 0.1 * k as f64;
+                let f = if k == 11 {
+                    3.0
+                } else if k == 25 {
+                    1.3
+                } else {
+                    1.0
+                };
+                TraceRow { object_height_m: 0.1, ..row(t, Phase::Transfer, f) }
+            })
+            .collect();
+        let push: PushConfig = toml::from_str("impulse_n_s = 0.3\nphase = \"transfer\"\noffset_s = 1.0").unwrap();
+        assert!((max_fluctuation_pct(&rows, None, |_| true).unwrap() - 200.0).abs() < 1e-9);
+        let outside = fluctuation_outside_push_pct(&rows, None, &push).unwrap();
+        assert!((outside - 30.0).abs() < 1e-9, "the 200 % impact left out, the 30 % after it kept: {outside}");
+        // Set down on the table at 13.0 s and pushed into the pad there: left out too.
+        let mut landed = rows.clone();
+        landed[30].force_n = 2.5;
+        landed[30].object_height_m = 0.001;
+        assert!((fluctuation_outside_push_pct(&landed, None, &push).unwrap() - 30.0).abs() < 1e-9);
+        // A push whose phase never came leaves out no impact; a dropped run has no fluctuation.
+        let lowering: PushConfig = toml::from_str("impulse_n_s = 0.3\nphase = \"lower\"").unwrap();
+        assert!((fluctuation_outside_push_pct(&rows, None, &lowering).unwrap() - 200.0).abs() < 1e-9);
+        assert_eq!(fluctuation_outside_push_pct(&rows, Some(12.5), &push), None);
+    }
 
     fn row(t: f64, phase: Phase, force: f64) -> TraceRow {
         TraceRow {

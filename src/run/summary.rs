@@ -203,6 +203,9 @@ pub fn render_text(s: &RunSummary) -> String {
     out += &format!("  rise time (90 %)   {}\n", opt(s.metrics.rise_time_90_s, "s"));
     out += &format!("  overshoot          {:.1} %\n", s.metrics.overshoot_pct);
     out += &format!("  max fluctuation    {}\n", opt(s.metrics.max_fluctuation_pct, "%"));
+    if s.metrics.max_fluctuation_outside_push_pct != s.metrics.max_fluctuation_pct {
+        out += &format!("    outside the push  {}\n", opt(s.metrics.max_fluctuation_outside_push_pct, "%"));
+    }
     out += &format!("  estimate RMSE      {}\n", opt(s.metrics.force_rmse_n, "N"));
     out += &format!(
         "  simulated {:.1} s in {:.2} s wall ({:.0}x real time), {:.2} s of CPU ({:.0}x)\n",

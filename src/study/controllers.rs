@@ -161,6 +161,7 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                 rise_time_s: s.metrics.rise_time_90_s,
                 overshoot_pct: started.then_some(s.metrics.overshoot_pct),
                 fluctuation_pct: s.metrics.max_fluctuation_pct,
+                fluctuation_outside_push_pct: s.metrics.max_fluctuation_outside_push_pct,
                 peak_force_n: s.metrics.peak_force_n,
                 drop_detection_delay_s: s.drop_detection_delay_s,
                 false_alarms: s.false_alarms,
@@ -192,6 +193,7 @@ fn run_cells(r: &ControllerRow) -> Vec<String> {
         cell(r.rise_time_s),
         cell(r.overshoot_pct),
         cell(r.fluctuation_pct),
+        cell(r.fluctuation_outside_push_pct),
         cell(r.peak_force_n),
         cell(r.drop_detection_delay_s),
         r.false_alarms.map_or(String::new(), |n| n.to_string()),
@@ -200,7 +202,7 @@ fn run_cells(r: &ControllerRow) -> Vec<String> {
 }
 
 /// The columns of `controllers_summary.csv`.
-pub const SUMMARY_COLUMNS: [&str; 18] = [
+pub const SUMMARY_COLUMNS: [&str; 20] = [
     "controller",
     "object",
     "disturbance",
@@ -210,6 +212,8 @@ pub const SUMMARY_COLUMNS: [&str; 18] = [
     "held_rate",
     "fluctuation_mean_pct",
     "fluctuation_worst_pct",
+    "outside_push_mean_pct",
+    "outside_push_worst_pct",
     "rise_mean_s",
     "rise_worst_s",
     "overshoot_mean_pct",
@@ -233,6 +237,8 @@ fn summary_cells(r: &SummaryRow) -> Vec<String> {
         r.held_rate.to_string(),
         cell(r.fluctuation_mean_pct),
         cell(r.fluctuation_worst_pct),
+        cell(r.outside_push_mean_pct),
+        cell(r.outside_push_worst_pct),
         cell(r.rise_mean_s),
         cell(r.rise_worst_s),
         cell(r.overshoot_mean_pct),
