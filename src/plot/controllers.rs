@@ -88,6 +88,7 @@ pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
                 .parse::<u64>()
                 .map_err(|_| r.error(format!("column `seed`: `{seed_text}` is not a whole number ≥ 0")))?;
             let phase = r.text(drop_phase);
+            let fluctuation_pct = r.opt_f64(fluctuation)?;
             Ok(ControllerRow {
                 controller: r.text(controller).to_string(),
                 object: r.text(object).to_string(),
@@ -98,10 +99,10 @@ pub fn read(path: &Path) -> Result<Vec<ControllerRow>, PlotError> {
                 drop_time_s: r.opt_f64(drop_time)?,
                 rise_time_s: r.opt_f64(rise)?,
                 overshoot_pct: r.opt_f64(overshoot)?,
-                fluctuation_pct: r.opt_f64(fluctuation)?,
+                fluctuation_pct,
                 fluctuation_outside_push_pct: match outside_push {
                     Some(c) => r.opt_f64(c)?,
-                    None => r.opt_f64(fluctuation)?,
+                    None => fluctuation_pct,
                 },
                 peak_force_n: r.opt_f64(peak)?,
                 drop_detection_delay_s: match delay {
