@@ -209,6 +209,7 @@ fn bad_fit_input_is_named_before_anything_runs() {
         &["fit.toml", "finger.relaxation_time_s", "min = -5"],
     );
     check(good.replace("evaluations = 10", "evaluations = 0"), &["fit.toml", "budget.evaluations"]);
+    check(good.replace("evaluations = 10", "evaluations = 10\nprescreen = 10"), &["fit.toml", "budget.prescreen"]);
     check(good.replace("[\"on\"]", "[\"nowhere\"]"), &["fit.toml", "recordings[0]", "nowhere"]);
     // A recording whose trace does not come at its scenario's control rate.
     let summary = dir.path().join("on/summary.json");

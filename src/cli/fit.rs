@@ -24,7 +24,8 @@ pub struct FitArgs {
     #[arg(long)]
     start: Option<PathBuf>,
     /// Most evaluations, instead of the fit file's `budget.evaluations` (1 with `--start`: score
-    /// those values, e.g. a hand calibration, without searching).
+    /// those values, e.g. a hand calibration, without searching); the prescreen shrinks to fit
+    /// inside it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     evaluations: Option<u64>,
     /// Continue the search logged in the output folder (evaluations already logged are not run
@@ -38,6 +39,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     fit.start_from(&crate::scenario::Overlay::load(a.start.as_deref())?)?;
     if let Some(n) = a.evaluations {
         fit.budget.evaluations = n as usize;
+        fit.budget.prescreen = fit.budget.prescreen.min(n as usize - 1);
     }
     let stem = a.fit.file_stem().map_or("fit".into(), |s| s.to_string_lossy().to_string());
     let out_dir = a.out.unwrap_or_else(|| PathBuf::from("out").join(format!("fit-{stem}")));

@@ -8,6 +8,11 @@
 //! and converges in a few hundred evaluations at this size. Bounds are handled by searching the
 //! unit cube of [`Parameter::to_unit`]: a candidate outside is evaluated at the nearest point inside
 //! and charged its squared distance, so the search is pulled back without a wall.
+//!
+//! CMA-ES is a local search: from a start on a plateau, or beside a narrow valley, it settles
+//! where it began (the paper fit: README, "Fit to the paper"). `budget.prescreen` first evaluates
+//! that many quasi-random points spread evenly over the whole cube ([`spread_points`]) and starts
+//! the search from the best of them and the start.
 
 use super::log::{EvalLog, EvalRecord, LogError};
 use super::space::Parameter;
@@ -33,11 +38,15 @@ pub struct Budget {
     pub seed: u64,
     /// Stop when the step is below this fraction of every range (converged).
     pub tolerance: f64,
+    /// Points spread over the whole range ([`spread_points`]) evaluated before the search, which
+    /// then starts from the best of them and the start (0: none, the search starts at the start).
+    /// Part of `evaluations`.
+    pub prescreen: usize,
 }
 
 impl Default for Budget {
     fn default() -> Budget {
-        Budget { evaluations: 300, population: None, step: 0.3, seed: 1, tolerance: 1e-4 }
+        Budget { evaluations: 300, population: None, step: 0.3, seed: 1, tolerance: 1e-4, prescreen: 0 }
     }
 }
 
@@ -55,6 +64,15 @@ impl Budget {
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
             return Some(("budget.tolerance".into(), format!("must be in (0, 1), got {}", self.tolerance)));
+        }
+        if self.prescreen >= self.evaluations {
+            return Some((
+                "budget.prescreen".into(),
+                format!(
+                    "must be below budget.evaluations ({}), which it is part of, got {}",
+                    self.evaluations, self.prescreen
+                ),
+            ));
         }
         None
     }
@@ -163,16 +181,25 @@ where
         objective + outside
     };
     // The start first: the baseline every later candidate is compared with (and the first point of
-    // the chart).
+    // the chart); then the prescreen, in parallel, and the search from the best point so far (the
+    // first of equals: the choice does not depend on the threads' timing).
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
-    pool.install(|| objective(&DVector::from_vec(start.clone())));
+    let dim = params.len();
+    let mut candidates = vec![start];
+    candidates.extend(spread_points(budget.prescreen, dim));
+    let scores: Vec<f64> = pool.install(|| {
+        use rayon::prelude::*;
+        candidates.par_iter().map(|u| objective(&DVector::from_vec(u.clone()))).collect()
+    });
+    let best_first = scores.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map_or(0, |(k, _)| k);
+    let start = candidates.swap_remove(best_first);
     // Whole generations only, so the budget never cuts one short: which candidates of a cut
     // generation ran would depend on the threads' timing, and the search would not repeat.
-    let dim = params.len();
+    let left = budget.evaluations - 1 - budget.prescreen;
     let mut lambda = budget.population.unwrap_or(4 + (3.0 * (dim as f64).ln()).floor() as usize);
-    let mut generations = (budget.evaluations - 1) / lambda;
-    if generations == 0 && budget.evaluations > 2 {
-        (lambda, generations) = (budget.evaluations - 1, 1);
+    let mut generations = left / lambda;
+    if generations == 0 && left > 1 {
+        (lambda, generations) = (left, 1);
     }
     let options = CMAESOptions::new(start, budget.step)
         .seed(budget.seed)
@@ -182,7 +209,7 @@ where
         .tol_fun(1e-9)
         .tol_fun_hist(1e-9)
         .tol_stagnation(usize::MAX / 2);
-    let mut cmaes = options.build(objective).map_err(|e| anyhow::anyhow!("the search cannot start: {e:?}"))?;
+    let mut cmaes = options.build(&objective).map_err(|e| anyhow::anyhow!("the search cannot start: {e:?}"))?;
     let stop = pool.install(|| {
         if generations == 0 {
             return "the budget holds the start only".to_string();
@@ -215,4 +242,87 @@ where
         .and_then(EvalRecord::exact_values)
         .unwrap_or_else(|| params.iter().map(|p| p.start).collect());
     Ok(SearchResult { best, best_record, history, reused, stop, wall_time_s: started.elapsed().as_secs_f64() })
+}
+
+/// `n` points of the unit cube of `dim` dimensions, spread evenly over it whatever `n`: Roberts'
+/// R_d sequence, x_k = frac(1/2 + k α) with α_i = φ_d^-(i+1) and φ_d the root of x^(d+1) = x + 1
+/// (the golden ratio for d = 1). Its points cover every dimension and every projection without the
+/// lines a Halton sequence draws in high dimensions at small `n`, and need no seed: the prescreen
+/// is the same in every session, so a resumed search finds its points in the log.
+pub fn spread_points(n: usize, dim: usize) -> Vec<Vec<f64>> {
+    let d = dim as f64;
+    // Newton on x^(d+1) - x - 1 from 2 (the root is in (1, 2) and the function convex there).
+    let mut phi = 2.0_f64;
+    for _ in 0..50 {
+        phi -= (phi.powf(d + 1.0) - phi - 1.0) / ((d + 1.0) * phi.powf(d) - 1.0);
+    }
+    let alpha: Vec<f64> = (1..=dim).map(|i| phi.powi(-(i as i32))).collect();
+    (1..=n).map(|k| alpha.iter().map(|a| (0.5 + k as f64 * a).fract()).collect()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::space::{ParameterSpec, Scale};
+
+    #[test]
+    fn spread_points_fill_every_dimension_evenly() {
+        for dim in [1, 2, 5, 10] {
+            let points = spread_points(64, dim);
+            assert_eq!(points.len(), 64);
+            for i in 0..dim {
+                // Each coordinate visits every eighth of its range 8 ± 3 times in 64 points.
+                let mut bins = [0; 8];
+                for p in &points {
+                    assert!((0.0..1.0).contains(&p[i]), "{p:?}");
+                    bins[(p[i] * 8.0) as usize] += 1;
+                }
+                assert!(bins.iter().all(|&b| (5..=11).contains(&b)), "dim {dim}, axis {i}: {bins:?}");
+            }
+        }
+        assert_eq!(spread_points(5, 3), spread_points(5, 3), "no seed: the same points every time");
+    }
+
+    /// Two basins: a wide, shallow one around the start (0.2, 0.2) and a narrow, deep one at
+    /// (0.8, 0.7) that a local search from the start does not see (its minimum is -1).
+    fn two_basins(x: &[f64]) -> f64 {
+        let r2 = |c: (f64, f64), w: f64| ((x[0] - c.0).powi(2) + (x[1] - c.1).powi(2)) / (w * w);
+        1.0 - 0.5 * (-r2((0.2, 0.2), 0.3)).exp() - 2.0 * (-r2((0.8, 0.7), 0.1)).exp()
+    }
+
+    fn search(prescreen: usize) -> SearchResult {
+        let spec =
+            |start| ParameterSpec { min: 0.0, max: 1.0, scale: Scale::Linear, start: Some(start), integer: false };
+        let params =
+            vec![Parameter::from_spec("a", &spec(0.2)).unwrap(), Parameter::from_spec("b", &spec(0.2)).unwrap()];
+        let dir = tempfile::tempdir().unwrap();
+        let keys = vec!["a".to_string(), "b".to_string()];
+        let (log, _) = EvalLog::open(&dir.path().join("evaluations.jsonl"), "test", &keys, false).unwrap();
+        let budget = Budget { evaluations: 120, step: 0.1, prescreen, ..Budget::default() };
+        minimize(&params, &budget, Some(2), log, Vec::new(), "test", |x| Evaluation {
+            objective: two_basins(x),
+            failed: false,
+            detail: serde_json::Value::Null,
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn a_prescreen_finds_the_narrow_basin_a_local_search_from_the_start_misses() {
+        let local = search(0);
+        assert!(local.best[0] < 0.5, "without a prescreen the search stays by its start: {:?}", local.best);
+        let screened = search(40);
+        let objective = screened.best_record.as_ref().and_then(EvalRecord::exact_objective).unwrap();
+        assert!((screened.best[0] - 0.8).abs() < 0.02 && (screened.best[1] - 0.7).abs() < 0.02, "{:?}", screened.best);
+        assert!(objective < -0.99, "{objective}");
+        assert!(screened.history.len() <= 120, "the prescreen is part of the budget: {}", screened.history.len());
+    }
+
+    #[test]
+    fn a_prescreen_as_large_as_the_budget_is_refused() {
+        let budget = Budget { evaluations: 10, prescreen: 10, ..Budget::default() };
+        let (key, reason) = budget.check().unwrap();
+        assert_eq!(key, "budget.prescreen");
+        assert!(reason.contains("below budget.evaluations"), "{reason}");
+    }
 }

@@ -28,6 +28,7 @@
 //! evaluations = 300
 //! step = 0.3
 //! seed = 1
+//! prescreen = 0          # points spread over the whole range first; the search starts at the best
 //! ```
 //! A fit needs recordings, targets, or both. The objective is the mean of every run's score: each
 //! recording's ([`super::objective`], in N) and each target seed's ([`super::target`], in

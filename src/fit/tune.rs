@@ -20,8 +20,8 @@
 //! rise_time_90_s = 0.05        # per s (a run that never reaches 90 %: its grasp time)
 //! overshoot_pct = 0.002        # per %
 //! peak_force_n = 0.0           # per N of the largest force while holding
-//! [budget]
-//! evaluations = 60
+//! [budget]                    # the fit's keys (src/fit/optimizer.rs): population, step, seed,
+//! evaluations = 60             # tolerance, prescreen
 //! ```
 
 use super::execute::{LOG_FILE, fnv, simulate};
