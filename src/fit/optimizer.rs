@@ -212,7 +212,8 @@ where
     let mut cmaes = options.build(&objective).map_err(|e| anyhow::anyhow!("the search cannot start: {e:?}"))?;
     let stop = pool.install(|| {
         if generations == 0 {
-            return "the budget holds the start only".to_string();
+            let what = if budget.prescreen > 0 { "the start and the prescreen" } else { "the start" };
+            return format!("the budget holds {what} only");
         }
         loop {
             let end = cmaes.next_parallel();
