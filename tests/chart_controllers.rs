@@ -154,9 +154,9 @@ fn the_fluctuation_outside_the_knock_leaves_out_its_impact() {
         dir.path().to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let summary: serde_json::Value =
+    // The metrics are flattened into the summary.
+    let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
-    let m = &summary; // the metrics are flattened into the summary
     let (all, outside) =
         (m["max_fluctuation_pct"].as_f64().unwrap(), m["max_fluctuation_outside_push_pct"].as_f64().unwrap());
     assert!(all > 100.0, "the knock goes through the pad: {all} %");
