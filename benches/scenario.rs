@@ -12,9 +12,16 @@ use tendril::run::execute::{ModelCache, run_on_twin};
 use tendril::run::scenario::PickPlaceScenario;
 use tendril::scenario::Override;
 
+/// The shipped scenario on `backend`: MuJoCo at the converged default; rapier at 32 links and a
+/// 5 ms step, the setting of README's rapier comparison (at the default 64 links and 1.25 ms it
+/// runs at about 0.1x real time, and `cargo test --all-targets` runs every bench once).
 fn scenario(name: &str, backend: Backend) -> PickPlaceScenario {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
-    tendril::scenario::load(&file, &[Override::backend(backend)]).expect("shipped scenarios load")
+    let mut overrides = vec![Override::backend(backend)];
+    if backend == Backend::Rapier {
+        overrides.extend(["finger.segments=32", "physics.timestep_s=0.005"].map(|s| s.parse().expect("valid")));
+    }
+    tendril::scenario::load(&file, &overrides).expect("shipped scenarios load")
 }
 
 fn full_scenario(c: &mut Criterion) {
@@ -26,7 +33,10 @@ fn full_scenario(c: &mut Criterion) {
     let timed = std::env::args().any(|a| a == "--bench");
     for (name, backend) in runs {
         let s = scenario(name, backend);
-        let name = format!("{name}_{}", backend.name());
+        let name = match backend {
+            Backend::Mujoco => format!("{name}_mujoco"),
+            Backend::Rapier => format!("{name}_rapier_32links_5ms"),
+        };
         let models = ModelCache::default();
         if timed {
             print_real_time_factor(&name, &s, &models);

@@ -9,8 +9,10 @@ use common::cli::{stderr, tendril};
 #[test]
 fn run_with_backend_rapier_names_it_in_the_summary() {
     let dir = tempfile::tempdir().unwrap();
-    let out =
-        tendril(&["run", "scenarios/short-lift.toml", "--backend", "rapier", "--out", dir.path().to_str().unwrap()]);
+    let mut args =
+        vec!["run", "scenarios/short-lift.toml", "--backend", "rapier", "--out", dir.path().to_str().unwrap()];
+    args.extend(RAPIER_NUMERICS);
+    let out = tendril(&args);
     assert!(out.status.success(), "{}", stderr(&out));
     let summary: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
@@ -40,20 +42,24 @@ fn bad_backend_settings_name_the_file_and_key() {
     assert!(!out.status.success() && stderr(&out).contains("bullet"), "{}", stderr(&out));
 }
 
-/// The rows rapier reproduces with MuJoCo's calibration on the default 32-link finger (README,
-/// "The rapier backend"): every no-feedback row of the crimper and the shampoo, and every feedback
-/// row but the crimper's fluctuation (rapier 47 %, MuJoCo 26 %). Without feedback rapier drops the
-/// hammer in the lift (9.9 s) where MuJoCo carries it to the lowering: reported, not asserted.
-const RAPIER_AGREES: [&str; 12] = [
-    "crimper, no feedback: outcome",
-    "crimper, no feedback: drop time after the arm starts [s]",
+/// rapier runs at about 0.1x real time on the converged default (64 links, 1.25 ms: the short lift's
+/// 12 s took 105 CPU-s), too slow for CI; its tests run at 32 links and a 5 ms step, the setting of
+/// README's rapier comparison.
+const RAPIER_NUMERICS: [&str; 4] = ["--set", "finger.segments=32", "--set", "physics.timestep_s=0.005"];
+
+/// The rows rapier reproduces with MuJoCo's calibration at [`RAPIER_NUMERICS`] (README, "The rapier
+/// backend"): every feedback row of the crimper and the hammer, the shampoo's outcome and rise with
+/// feedback, and its drop without (14.4 s in the transfer). Reported, not asserted: rapier drops the
+/// crimper in the transfer (13.5 s) and the hammer in the lift (8.1 s), and the shampoo's
+/// fluctuation with feedback is 96 %.
+const RAPIER_AGREES: [&str; 10] = [
     "crimper, feedback: outcome",
     "crimper, feedback: rise to 90 % of 0.6 N [s]",
+    "crimper, feedback: largest fluctuation while moving [%]",
     "shampoo, no feedback: outcome",
     "shampoo, no feedback: drop time after the arm starts [s]",
     "shampoo, feedback: outcome",
     "shampoo, feedback: rise to 90 % of 0.8 N [s]",
-    "shampoo, feedback: largest fluctuation while moving [%]",
     "hammer, feedback: outcome",
     "hammer, feedback: rise to 90 % of 1.6 N [s]",
     "hammer, feedback: largest fluctuation while moving [%]",
@@ -63,7 +69,9 @@ const RAPIER_AGREES: [&str; 12] = [
 fn reproduce_gripper_on_rapier_passes_the_rows_it_agrees_on() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("rows.json");
-    let out = tendril(&["reproduce", "gripper", "--backend", "rapier", "--json", json.to_str().unwrap()]);
+    let mut args = vec!["reproduce", "gripper", "--backend", "rapier", "--json", json.to_str().unwrap()];
+    args.extend(RAPIER_NUMERICS);
+    let out = tendril(&args);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<Value> = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(rows.len(), 15, "{stdout}");

@@ -49,10 +49,12 @@ fn a_steady_grip_under_thirty_picometres_of_noise_raises_no_alarm() {
 #[test]
 fn without_feedback_the_pad_loses_the_crimper_seconds_before_it_falls() {
     // The object then hangs on the palm's pinch (models/README.md): the sensor's loss is a false
-    // alarm by the ground truth, and the drop itself is not seen.
+    // alarm by the ground truth, and the drop itself is not seen. On the converged default the pad
+    // lets go 1.6 s before the crimper falls (seed 1: alarm 8.37 s, drop 9.96 s; 4-8 s on the
+    // coarser 32-link finger).
     let s = run("crimper", &["feedback=false"]);
     assert_eq!(s.outcome, "dropped");
     let (drop, alarm) = (s.drop_time_s.unwrap(), s.drop_alarm_s.expect("the pad's loss is an alarm"));
-    assert!(drop - alarm > 3.0, "alarm at {alarm} s, drop at {drop} s");
+    assert!(drop - alarm > 1.0, "alarm at {alarm} s, drop at {drop} s");
     assert_eq!((s.false_alarms, s.drop_detection_delay_s), (Some(1), None));
 }

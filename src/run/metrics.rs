@@ -72,14 +72,19 @@ fn band_swings(rows: &[&TraceRow]) -> usize {
 /// approach is timed as before.
 pub const SPIKE_FILTER_TICKS: usize = 5;
 
-/// The rows' estimates through a centred running median of [`SPIKE_FILTER_TICKS`] (shorter at
-/// the ends).
+/// The rows' estimates through [`despiked`].
 fn despiked_force(rows: &[&TraceRow]) -> Vec<f64> {
+    despiked(&rows.iter().map(|r| r.force_n).collect::<Vec<_>>())
+}
+
+/// A signal sampled once per control tick through a centred running median of
+/// [`SPIKE_FILTER_TICKS`] (shorter at the ends): one- and two-tick impacts removed, levels and
+/// crossings kept.
+pub fn despiked(values: &[f64]) -> Vec<f64> {
     let half = SPIKE_FILTER_TICKS / 2;
-    (0..rows.len())
+    (0..values.len())
         .map(|i| {
-            let mut w: Vec<f64> =
-                rows[i.saturating_sub(half)..(i + half + 1).min(rows.len())].iter().map(|r| r.force_n).collect();
+            let mut w = values[i.saturating_sub(half)..(i + half + 1).min(values.len())].to_vec();
             w.sort_by(f64::total_cmp);
             w[w.len() / 2]
         })

@@ -159,10 +159,11 @@ pub enum ArmMode {
 
 /// `[physics]`: MuJoCo options and the divergence bounds.
 ///
-/// Defaults follow MuJoCo's advice for slip accuracy (elliptic cones, large impratio, Newton solver with
-/// a small tolerance, then noslip iterations; modeling.md measured that pyramidal cones creep and a held
-/// box creeps without noslip) at the largest step that passes tests/physics_validation.rs, chosen for
-/// the full scene's speed (~100x real time, benches/physics.rs; models/README.md has the figures).
+/// Defaults are the converged setting (README, "Convergence"): elliptic cones and a Newton solver with
+/// a small tolerance (MuJoCo's advice for slip accuracy; modeling.md measured that pyramidal cones
+/// creep), stiff contacts that hold objects without noslip iterations, and the largest step at which
+/// the Section V answers agree with half that step. About 8x real time on one core
+/// (benches/scenario.rs; README, "Speed and accuracy").
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
@@ -174,19 +175,21 @@ pub struct PhysicsConfig {
     /// copies built into the binary.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub models_dir: Option<PathBuf>,
-    /// Simulation step \[s\]. 5 ms: the largest step at which the contact time constant (10 ms) is still
-    /// two steps (MuJoCo's minimum) and the pinch bound holds to 0.02 %; 2 ms runs ~2.5x slower.
+    /// Simulation step \[s\]. 1.25 ms: the largest step whose Section V answers agree with half the
+    /// step by the convergence criteria (drops within 0.25 s, fluctuations within 3 points, seed 1);
+    /// at 2.5 ms the shampoo's fluctuation with feedback is 8 points off. It is also four steps of
+    /// the 5 ms contact time constant, so the contact dynamics are resolved, not clamped to
+    /// MuJoCo's two-step minimum. A numerical choice, not a calibration knob (README, "Convergence").
     pub timestep_s: f64,
     /// Integrator. `implicitfast`: the creep dashpot (thousands of N s/m on a 1 g node) and the servos'
     /// `kv` are integrated implicitly, which explicit Euler would not survive at this step.
     pub integrator: Integrator,
     /// Friction cone. `elliptic`: exact Coulomb limit (pyramidal creeps, modeling.md).
     pub cone: Cone,
-    /// Ratio of frictional to normal constraint impedance. 3: with the 20 ms contact time constant at
-    /// the 5 ms step, the pinch test's smallest holding force is the analytic one (−0.1 %,
-    /// tests/physics_validation.rs); 10, chosen with 10 ms contacts to stop a held object creeping,
-    /// needs 24 % more force there (the stiffer friction rows let the box slip at 5 ms), and 1 and 3
-    /// both meet the bound.
+    /// Ratio of frictional to normal constraint impedance. 3: the pinch test's smallest holding
+    /// force is the analytic one (tests/physics_validation.rs; measured with 20 ms contacts at 5 ms,
+    /// −0.1 %, and with the default 5 ms contacts at 1.25 ms, +0.02 %); 10, chosen earlier with 10 ms
+    /// contacts to stop a held object creeping, needed 24 % more force there at 5 ms.
     pub impratio: f64,
     /// Newton solver iterations (upper bound; it usually converges in 2-5).
     pub iterations: u32,
@@ -198,17 +201,21 @@ pub struct PhysicsConfig {
     /// Line-search iterations of the Newton solver. 20: with 5 the object sank 14 mm into the table
     /// during a grasp (measured).
     pub ls_iterations: u32,
-    /// Post-solve no-slip iterations. 10: removes the residual tangential creep of soft contacts
-    /// (modeling.md: a held box crept ~1 mm/s until noslip was added); at 5 ms, 0 or 4 iterations left
-    /// the pinch holding force 6-8 % above m(g+a)/2mu, 10 gives 0.02 %. About a third of a step's time.
+    /// Post-solve no-slip iterations. 0: the stiff 5 ms contacts already hold the pinch test's box at
+    /// its analytic force (+0.02 %) and stop the slope test's creep. Noslip is a projection applied after
+    /// the step, and its answers moved with the step: with 10 iterations and 20 ms contacts the
+    /// crimper's fluctuation with feedback went 14 -> 49 -> 68 % at 5 / 2.5 / 1.25 ms (README,
+    /// "Convergence"). Soft 20 ms contacts need it (at 5 ms, 0 iterations left the pinch force
+    /// 6-8 % above m(g+a)/2mu).
     pub noslip_iterations: u32,
     /// No-slip solver tolerance.
     pub noslip_tolerance: f64,
-    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 0.02 s: four steps at
-    /// the default 5 ms step, so the contact dynamics are resolved by the integrator instead of being
-    /// clamped to MuJoCo's two-step minimum; at 0.01 s (two steps) the crimper's rise and fluctuation
-    /// moved with the timestep (README, "Convergence"). With the finger's armature the strip sinks
-    /// about 1 mm into the objects.
+    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 5 ms: stiff enough
+    /// that soft-contact creep does not let a held object slide without noslip (the slope and pinch
+    /// tests in tests/physics_validation.rs pass with noslip off), and four steps at the 1.25 ms
+    /// default, so the contact dynamics are resolved by the integrator instead of being clamped to
+    /// MuJoCo's two-step minimum. A numerical stiffness of the soft-contact model, not a material
+    /// property: at 0.625 ms (eight steps) the Section V answers are the default's.
     pub contact_timeconst_s: f64,
     /// Contact solref damping ratio (1 = critical).
     pub contact_dampratio: f64,
@@ -220,10 +227,10 @@ pub struct PhysicsConfig {
     /// maximum 180 deg/s (hardware.md). Targets further away are approached at this speed.
     pub arm_max_speed_rad_s: f64,
     /// Divergence bound: deepest allowed contact penetration \[m\]. 30 mm: a dropped object falls
-    /// through the finger or onto the table at up to ~1.5 m/s (a 12 cm fall), and soft contacts with
-    /// their 20 ms time constant let it in by about v × 20 ms before pushing it out (5 mm, and 15 mm
-    /// with 10 ms contacts, turned such drops into "physics failed" errors). A blown-up simulation
-    /// still goes far past 30 mm.
+    /// through the finger or onto the table at up to ~1.5 m/s (a 12 cm fall), and soft contacts let it
+    /// in by about v × their time constant before pushing it out (30 mm with 20 ms contacts; a 5 mm
+    /// bound turned such drops into "physics failed" errors). A blown-up simulation still goes far
+    /// past 30 mm.
     pub max_penetration_m: f64,
     /// Divergence bound: largest allowed kinetic energy of the scene \[J\]. The cell's moving parts hold
     /// < 5 J at UR5e speeds (20 kg arm at 0.5 m/s); 200 J means runaway.
@@ -236,16 +243,16 @@ impl Default for PhysicsConfig {
     fn default() -> Self {
         PhysicsConfig {
             backend: Backend::Mujoco,
-            timestep_s: 0.005,
+            timestep_s: 0.00125,
             integrator: Integrator::Implicitfast,
             cone: Cone::Elliptic,
             impratio: 3.0,
             iterations: 50,
             tolerance: 1e-8,
             ls_iterations: 20,
-            noslip_iterations: 10,
+            noslip_iterations: 0,
             noslip_tolerance: 1e-8,
-            contact_timeconst_s: 0.02,
+            contact_timeconst_s: 0.005,
             contact_dampratio: 1.0,
             contact_solimp: [0.95, 0.99, 0.001],
             arm_mode: ArmMode::Kinematic,
@@ -305,9 +312,10 @@ impl Validate for PhysicsConfig {
 #[serde(deny_unknown_fields, default)]
 pub struct FingerConfig {
     /// Number of strip segments (discretisation; the pad's casing and the tip's anchor are single
-    /// rigid pieces at any number, `strip::layout`). 32: 4.4 mm links, about 19 per turn around a
-    /// 12.5 mm-radius handle, the coarsest finger whose answers agree with 64 links on outcome, rise
-    /// and fluctuation (README, "Convergence"; 16 links moved the drops by 1.4-2.7 s).
+    /// rigid pieces at any number, `strip::layout`). 64: 2.2 mm links, about 38 per turn around a
+    /// 12.5 mm-radius handle, the coarsest finger whose drop times agree with 128 links within 0.5 s
+    /// (README, "Convergence"; at 32 links the drops came 1.6-2.0 s later than at 64, at 16 links
+    /// later still). A numerical choice, not a calibration knob.
     pub segments: u32,
     /// How many times finer than `segments` implies the links are between the strip's base and the
     /// pad's casing (1: a uniform grid). A numerical choice, like `segments`: that stretch holds the
@@ -380,9 +388,10 @@ pub struct FingerConfig {
     pub relaxed_fraction: f64,
     /// Relaxation time tau \[s\] of the standard linear solid (dashpot c = tau (1 - f) K).
     /// Tuned so that, as in the paper, the three objects drop ≈ 10, 13 and 17 s after the arm
-    /// starts: 15 s, with the objects' friction margins, turns the decay of the frozen grip into those
-    /// drop times (models/README.md has the figures); 20-30 s let the crimper survive the lift. Seconds
-    /// to tens of seconds is the usual range of TPU stress relaxation.
+    /// starts: 18 s, with the objects' friction margins, turns the decay of the frozen grip into those
+    /// drop times on the converged finger (models/README.md has the figures: 15 s, the value on the
+    /// coarser 32-link finger, dropped all three 1.6-2.0 s early at 64 links; 21 s let the hammer
+    /// survive). Seconds to tens of seconds is the usual range of TPU stress relaxation.
     pub relaxation_time_s: f64,
     /// Equivalent translating inertia of each MX-106 at its output \[kg\] (joint armature). A choice.
     pub motor_armature_kg: f64,
@@ -420,7 +429,7 @@ pub struct FingerConfig {
 impl Default for FingerConfig {
     fn default() -> Self {
         FingerConfig {
-            segments: 32,
+            segments: 64,
             base_refinement: 1,
             length_m: 0.14,
             thickness_m: 0.002,
@@ -433,7 +442,7 @@ impl Default for FingerConfig {
             tendon_tension_decay_per_m: 25.0,
             tendon_stiffness_n_m: 6000.0,
             relaxed_fraction: 0.05,
-            relaxation_time_s: 15.0,
+            relaxation_time_s: 18.0,
             motor_armature_kg: 2.0,
             motor_kp_n_m: 20000.0,
             motor_kv_n_s_m: 400.0,
@@ -456,12 +465,12 @@ impl FingerConfig {
 
 impl Validate for FingerConfig {
     fn validate(&self, at: &mut Checker) {
-        // 128: four doublings of 8 links for the convergence study (1.1 mm segments on a 14 cm strip,
-        // finer than the strip's 2 mm thickness, so nothing finer describes the strip any better).
-        at.require("segments", (2..=128).contains(&self.segments), || {
-            format!("must be between 2 and 128, got {}", self.segments)
+        // 256: the convergence study's links x4 from the 64-link default (0.55 mm segments on a 14 cm
+        // strip, a quarter of the strip's 2 mm thickness; nothing finer describes the strip better).
+        at.require("segments", (2..=256).contains(&self.segments), || {
+            format!("must be between 2 and 256, got {}", self.segments)
         });
-        // 8: the base stretch's links are then 0.55 mm at 32 links, a quarter of the strip's thickness.
+        // 8: the base stretch's links are then 0.27 mm at 64 links, an eighth of the strip's thickness.
         at.require("base_refinement", (1..=8).contains(&self.base_refinement), || {
             format!("must be between 1 and 8, got {}", self.base_refinement)
         });

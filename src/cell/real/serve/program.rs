@@ -30,8 +30,8 @@ pub const LOG_LINES: usize = 500;
 pub enum ArmCommand {
     /// Keep the last command.
     Keep,
-    /// Move to these joint angles \[rad\] (a `servoj` target: commanded at once, the twin's arm
-    /// spreads the move over the time since the previous one, see [`crate::cell::real::urscript::motion`]).
+    /// Move to these joint angles \[rad\] (a `servoj` target: the twin's arm reaches it one
+    /// program cycle later at a constant speed from the previous target, whatever its physics step).
     Move([f64; 6]),
     /// Follow a generated trajectory: the setpoint `q` \[rad\] at twin time `at_s` \[s\] moving at
     /// `qd` \[rad/s\]. The twin commands the setpoint extrapolated to the end of each physics step:

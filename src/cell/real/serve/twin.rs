@@ -221,6 +221,38 @@ fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64,
     (t, std::array::from_fn(|j| before.1[j] + (after.1[j] - before.1[j]) * f))
 }
 
+/// A setpoint moving at a constant speed, which the twin samples at the end of each physics step.
+#[derive(Debug, Clone, Copy)]
+struct Tracking {
+    /// Joint angles at `at_s` \[rad\].
+    q: [f64; 6],
+    /// Their speed \[rad/s\].
+    qd: [f64; 6],
+    /// Twin time of `q` \[s\].
+    at_s: f64,
+    /// How far past `at_s` the setpoint moves on \[s\].
+    max_ahead_s: f64,
+}
+
+impl Tracking {
+    /// A `servoj` target: reached one program cycle after it is given, at a constant speed from
+    /// where the previous target left the arm (servoj's `t` of one cycle). Commanding the target at
+    /// the next physics step instead made the arm's speed depend on how many steps fell in each
+    /// cycle: with 1.25 ms steps and 2 ms cycles it moved one cycle's way in 1.25 ms, then in
+    /// 2.5 ms, and the shaking let a held crimper go in the short lift (the estimate 0.15-1.6 N
+    /// against 0.53-0.58 N on the simulated path; measured).
+    fn servo(from: [f64; 6], to: [f64; 6], now_s: f64) -> Tracking {
+        let qd = std::array::from_fn(|j| (to[j] - from[j]) / CONTROL_PERIOD_S);
+        Tracking { q: from, qd, at_s: now_s, max_ahead_s: CONTROL_PERIOD_S }
+    }
+
+    /// The setpoint at twin time `t_s`, held at its end once `max_ahead_s` has passed.
+    fn at(&self, t_s: f64) -> [f64; 6] {
+        let ahead = (t_s - self.at_s).clamp(0.0, self.max_ahead_s);
+        std::array::from_fn(|j| self.q[j] + self.qd[j] * ahead)
+    }
+}
+
 /// Runs the twin in real time on its own thread (the MuJoCo data stays on it).
 pub fn spawn(
     scenario: PickPlaceScenario,
@@ -261,8 +293,9 @@ pub fn spawn(
         let mut measured_q = first.arm_q;
         // The virtual controller's program (the URScript interpreter).
         let mut program = ProgramRunner::default();
-        // A generated trajectory's latest setpoint, its speed and time (see `ArmCommand::Track`).
-        let mut tracking: Option<([f64; 6], [f64; 6], f64)> = None;
+        // The setpoint the arm follows between program cycles: where it is at a time, its speed,
+        // and how far past that time it may be extrapolated (see `ArmCommand::Track` and `Move`).
+        let mut tracking: Option<Tracking> = None;
         let timestep_s = scenario.physics.timestep_s;
         {
             let mut s = lock(&state);
@@ -293,13 +326,13 @@ pub fn spawn(
                 let mut new = match program.tick(&mut s, now_s, measured_q) {
                     ArmCommand::Keep => false,
                     ArmCommand::Track { q, qd, at_s } => {
-                        tracking = Some((q, qd, at_s));
+                        // Never more than a step and a cycle ahead of the program's last setpoint.
+                        tracking = Some(Tracking { q, qd, at_s, max_ahead_s: timestep_s + CONTROL_PERIOD_S });
                         false
                     }
                     ArmCommand::Move(q) => {
-                        tracking = None;
-                        command.arm_q = q;
-                        true
+                        tracking = Some(Tracking::servo(command.arm_q, q, now_s));
+                        false
                     }
                     ArmCommand::Hold => {
                         tracking = None;
@@ -310,14 +343,12 @@ pub fn spawn(
                 // The physics steps in this tick's wait: command the trajectory's setpoint at the
                 // step's end (a step is due once the wait passes half of it, as `wait_until` runs).
                 let physics_s = last_step.0;
-                if let Some((q, qd, at_s)) = tracking
+                if let Some(t) = tracking
                     && k as f64 * period_s - physics_s > 0.5 * timestep_s
                 {
-                    // Never more than a step and a cycle ahead of the program's last setpoint.
-                    let ahead = (physics_s + timestep_s - at_s).clamp(0.0, timestep_s + CONTROL_PERIOD_S);
-                    command.arm_q = std::array::from_fn(|j| q[j] + qd[j] * ahead);
+                    command.arm_q = t.at(physics_s + timestep_s);
                     new = true;
-                    if qd.iter().all(|v| *v == 0.0) {
+                    if t.qd.iter().all(|v| *v == 0.0) {
                         tracking = None;
                     }
                 }
