@@ -12,7 +12,7 @@ const SCENARIO: &str = "scenarios/short-lift.toml";
 
 /// The fit's machinery is under test here, not the physics: the recordings, and so every candidate
 /// (which re-runs a recording's own scenario), use 32 links at a 5 ms step, about 7x faster than
-/// the converged default (1.25 ms, 64 links). README "Fit to the paper" fits the default itself.
+/// the converged default (1.25 ms, 64 links). README, "Fit to the paper", scores the default itself.
 const QUICK_NUMERICS: [&str; 4] = ["--set", "finger.segments=32", "--set", "physics.timestep_s=0.005"];
 
 /// The recordings' lift is 10 s instead of 3 s: a frozen grip (feedback off) is seen creeping long

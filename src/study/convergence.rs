@@ -396,7 +396,7 @@ mod tests {
                 ("finest", "finest links /2")
             ]
         );
-        // A default at or below 0.625 ms is still halved twice: step/2 and step/4 are always judged.
+        // A default one halving from 0.625 ms is still halved twice: step/2 and step/4 are always judged.
         let fine = Plan::full(0.00125, 64);
         let steps: Vec<(&str, f64)> = fine.settings.iter().take(4).map(|s| (s.label.as_str(), s.timestep_s)).collect();
         assert_eq!(steps, [("default", 0.00125), ("step/2", 0.000625), ("step/4", 0.0003125), ("links x2", 0.00125)]);
