@@ -263,6 +263,28 @@ fn speed_accuracy_chart_and_front() {
     assert!(svg.contains("default: 2 ms") && svg.contains("reference: 500 µs"));
 }
 
+/// The study's newer columns: a CG point gets its own series, a graded finger its grading in labels.
+#[test]
+fn speed_accuracy_chart_names_solver_and_graded_finger() {
+    let (_keep, dir) = workdir("speed-graded");
+    let csv = "backend,integrator,cone,solver,timestep_s,segments,base_refinement,sim_s_per_cpu_s,force_rmse_n,drop_time_error_s,status,is_default,is_reference
+mujoco,implicitfast,elliptic,newton,0.0003125,256,1,0.1,0,0,ok,false,true
+mujoco,implicitfast,elliptic,newton,0.00125,64,1,8,0.01,0.3,ok,true,false
+mujoco,implicitfast,elliptic,cg,0.00125,64,1,12,0.012,0.3,ok,false,false
+mujoco,implicitfast,elliptic,newton,0.00125,8,8,20,0.009,0.2,ok,false,false
+";
+    std::fs::write(dir.join("speed_accuracy.csv"), csv).unwrap();
+    let rows = plot::speed_accuracy::read(&dir.join("speed_accuracy.csv")).unwrap();
+    assert_eq!((rows[2].solver.as_str(), rows[3].base_refinement), ("cg", 8));
+    assert_eq!((rows[1].solver.as_str(), rows[1].base_refinement), ("newton", 1));
+    // The graded finger is faster and more accurate than both 64-link points: the front's only one.
+    assert_eq!(plot::speed_accuracy::pareto_front(&rows), vec![3]);
+    plot::speed_accuracy::render(&rows, &dir).unwrap();
+    let svg = std::fs::read_to_string(dir.join("speed_accuracy.svg")).unwrap();
+    assert!(svg.contains("implicitfast + CG"), "the CG series is in the legend");
+    assert!(svg.contains("8 links (base x8)"), "the front's graded point is labelled with its grading");
+}
+
 #[test]
 fn stability_chart_marks_largest_stable() {
     let (_keep, dir) = workdir("stability");

@@ -44,6 +44,23 @@ fn a_friction_override_is_written_into_the_exported_grip() {
 }
 
 #[test]
+fn the_solver_key_chooses_mujocos_solver_and_an_unknown_one_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let option = |path: std::path::PathBuf| {
+        let xml = std::fs::read_to_string(path).unwrap();
+        let at = xml.find("<option ").unwrap();
+        xml[at..at + xml[at..].find('>').unwrap()].to_string()
+    };
+    assert!(option(export(dir.path(), "scenarios/crimper.toml", &[])).contains("solver=\"Newton\""));
+    let cg = export(dir.path(), "scenarios/shampoo.toml", &["--set", "physics.solver=\"cg\""]);
+    assert!(option(cg.clone()).contains("solver=\"CG\""));
+    assert_eq!(mujoco_rs::prelude::MjModel::from_xml(&cg).unwrap().ffi().opt.solver, 1, "mjSOL_CG");
+    let o = tendril(&["scene", "scenarios/crimper.toml", "--set", "physics.solver=\"lu\""]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("physics.solver"), "{}", stderr(&o));
+}
+
+#[test]
 fn a_bad_scenario_is_an_error_naming_the_key_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("scene.xml");

@@ -63,7 +63,8 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
         "speed-accuracy" => {
             let grid = if a.quick { study::speed_accuracy::Grid::quick() } else { study::speed_accuracy::Grid::full() };
             let p = PhysicsConfig::default();
-            let defaults = (p.timestep_s, "implicitfast", "elliptic", FingerConfig::default().segments);
+            let f = FingerConfig::default();
+            let defaults = (p.timestep_s, "implicitfast", "elliptic", f.segments, f.base_refinement);
             study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, defaults, &out, a.threads)?
         }
         "stability" => {

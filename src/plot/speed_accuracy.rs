@@ -20,10 +20,14 @@ pub struct SpeedAccuracyRow {
     pub integrator: String,
     /// Friction cone ("pyramidal", "elliptic").
     pub cone: String,
+    /// Constraint solver ("newton", "cg", "pgs"; "newton" when the file has no such column).
+    pub solver: String,
     /// Physics timestep \[s\].
     pub timestep_s: f64,
     /// Finger links.
     pub segments: u32,
+    /// `finger.base_refinement` (1, a uniform strip, when the file has no such column).
+    pub base_refinement: u32,
     /// Simulated seconds per CPU second of the run's thread (None if the run failed before measuring).
     pub sim_s_per_cpu_s: Option<f64>,
     /// RMSE of the sensor force against the reference run \[N\].
@@ -47,6 +51,7 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
     let (speed, rmse, drop, status) =
         (c("sim_s_per_cpu_s")?, c("force_rmse_n")?, c("drop_time_error_s")?, c("status")?);
     let (default, reference) = (c("is_default")?, c("is_reference")?);
+    let (solver, refinement) = (t.optional_column("solver"), t.optional_column("base_refinement"));
     let rows = t
         .iter()
         .map(|r| {
@@ -55,10 +60,13 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
                 backend: r.text(backend).to_string(),
                 integrator: r.text(integrator).to_string(),
                 cone: r.text(cone).to_string(),
+                solver: solver.map_or("newton", |c| r.text(c)).to_string(),
                 timestep_s: r.positive(dt)?,
-                segments: segments
-                    .parse()
-                    .map_err(|_| r.error(format!("column `segments`: `{segments}` is not a whole number")))?,
+                segments: whole(&r, "segments", segments)?,
+                base_refinement: match refinement {
+                    Some(c) => whole(&r, "base_refinement", r.text(c))?,
+                    None => 1,
+                },
                 sim_s_per_cpu_s: r.opt_f64(speed)?,
                 force_rmse_n: r.opt_f64(rmse)?,
                 drop_time_error_s: r.opt_f64(drop)?,
@@ -72,6 +80,11 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
         return Err(t.empty("no rows to plot"));
     }
     Ok(rows)
+}
+
+/// A whole-number cell of `column`.
+fn whole(r: &super::input::Row<'_>, column: &str, text: &str) -> Result<u32, PlotError> {
+    text.parse().map_err(|_| r.error(format!("column `{column}`: `{text}` is not a whole number")))
 }
 
 /// Indices of the rows on the Pareto front (faster and/or more accurate than all others),
@@ -104,9 +117,16 @@ struct SpeedAccuracy {
     rows: Vec<SpeedAccuracyRow>,
 }
 
+/// The colour series a row belongs to: its integrator, and its solver when that is not the
+/// default (Newton on MuJoCo, PGS on rapier).
+fn series(r: &SpeedAccuracyRow) -> String {
+    if r.solver == "cg" { format!("{} + CG", r.integrator) } else { r.integrator.clone() }
+}
+
 /// Short description of a row's settings, for labels.
 fn settings(r: &SpeedAccuracyRow) -> String {
-    format!("{}, {} links, {}", style::timestep(r.timestep_s), r.segments, r.cone)
+    let graded = if r.base_refinement > 1 { format!(" (base x{})", r.base_refinement) } else { String::new() };
+    format!("{}, {} links{graded}, {}", style::timestep(r.timestep_s), r.segments, r.cone)
 }
 
 impl SpeedAccuracy {
@@ -153,10 +173,11 @@ impl SpeedAccuracy {
             .x_label_formatter(&|v| style::num(*v))
             .y_label_formatter(&|v| style::num(*v))
             .draw()?;
-        let integrators = grid::first_seen(self.rows.iter().map(|r| r.integrator.as_str()));
+        let keys: Vec<String> = self.rows.iter().map(series).collect();
+        let integrators = grid::first_seen(keys.iter().map(String::as_str));
         let backends = grid::first_seen(self.rows.iter().map(|r| r.backend.as_str()));
         chart.draw_series(drops.iter().map(|(r, s, e)| {
-            let k = integrators.iter().position(|i| *i == r.integrator).unwrap_or(0);
+            let k = integrators.iter().position(|i| *i == series(r)).unwrap_or(0);
             let m = backends.iter().position(|b| *b == r.backend).unwrap_or(0);
             let y = if *e > 0.0 { *e } else { y_lo * 1.3 };
             marker(m, (*s, y), style::SERIES[k % style::SERIES.len()])
@@ -222,14 +243,15 @@ impl Chart for SpeedAccuracy {
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(60, 60, 60).stroke_width(2)));
 
-        let integrators = grid::first_seen(self.rows.iter().map(|r| r.integrator.as_str()));
+        let keys: Vec<String> = self.rows.iter().map(series).collect();
+        let integrators = grid::first_seen(keys.iter().map(String::as_str));
         let backends = grid::first_seen(self.rows.iter().map(|r| r.backend.as_str()));
         for (k, integrator) in integrators.iter().enumerate() {
             let color = style::SERIES[k % style::SERIES.len()];
             for (m, backend) in backends.iter().enumerate() {
                 let pts: Vec<(f64, f64)> = ok
                     .iter()
-                    .filter(|(r, _, _)| r.integrator == *integrator && r.backend == *backend)
+                    .filter(|(r, _, _)| series(r) == *integrator && r.backend == *backend)
                     .map(|(_, s, e)| (*s, *e))
                     .collect();
                 if pts.is_empty() {

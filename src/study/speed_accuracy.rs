@@ -35,6 +35,12 @@ pub struct Grid {
     /// The reference: timestep \[s\] and links (MuJoCo, implicitfast, elliptic cone: the finest
     /// setting of the convergence study, where the integrators agree).
     pub reference: (f64, u32),
+    /// Graded fingers (links, `finger.base_refinement`) run at every MuJoCo timestep with
+    /// implicitfast and elliptic cones: the strip cut finer only between its base and the pad.
+    pub graded: Vec<(u32, u32)>,
+    /// Other MuJoCo constraint solvers (`physics.solver`) run at every MuJoCo timestep with
+    /// implicitfast, elliptic cones and each of `segments`.
+    pub solvers: Vec<&'static str>,
 }
 
 impl Grid {
@@ -51,6 +57,8 @@ impl Grid {
             rapier_timesteps_s: vec![0.0025, 0.005],
             rapier_segments: vec![32],
             reference: (0.0003125, 256),
+            graded: vec![(8, 8), (16, 8), (16, 4), (32, 2)],
+            solvers: vec!["cg"],
         }
     }
 
@@ -65,6 +73,8 @@ impl Grid {
             rapier_timesteps_s: vec![0.002, 0.005],
             rapier_segments: vec![16],
             reference: (0.0025, 32),
+            graded: vec![(8, 2)],
+            solvers: vec![],
         }
     }
 }
@@ -77,12 +87,22 @@ struct Point {
     integrator: String,
     cone: String,
     segments: u32,
+    base_refinement: u32,
+    solver: &'static str,
     rapier_iterations: Option<u32>,
 }
 
 impl Point {
     fn mujoco(timestep_s: f64, integrator: &str, cone: &str, segments: u32) -> Point {
-        Point { timestep_s, integrator: integrator.into(), cone: cone.into(), segments, rapier_iterations: None }
+        Point {
+            timestep_s,
+            integrator: integrator.into(),
+            cone: cone.into(),
+            segments,
+            base_refinement: 1,
+            solver: "newton",
+            rapier_iterations: None,
+        }
     }
 
     fn rapier(timestep_s: f64, iterations: u32, segments: u32) -> Point {
@@ -91,6 +111,8 @@ impl Point {
             integrator: format!("pgs ({iterations} it.)"),
             cone: "coulomb".into(),
             segments,
+            base_refinement: 1,
+            solver: "pgs",
             rapier_iterations: Some(iterations),
         }
     }
@@ -99,12 +121,14 @@ impl Point {
         let mut o = vec![
             set("physics.timestep_s", self.timestep_s),
             set("finger.segments", self.segments),
+            set("finger.base_refinement", self.base_refinement),
             set("feedback", false),
         ];
         match self.rapier_iterations {
             None => o.extend([
                 set("physics.integrator", format!("\"{}\"", self.integrator)),
                 set("physics.cone", format!("\"{}\"", self.cone)),
+                set("physics.solver", format!("\"{}\"", self.solver)),
             ]),
             Some(it) => o.extend([set("physics.backend", "\"rapier\""), set("physics.rapier.solver_iterations", it)]),
         }
@@ -113,12 +137,12 @@ impl Point {
 }
 
 /// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`.
-/// `defaults` names the project's default settings (timestep, integrator, cone, links) to
-/// highlight; `threads` runs at once (speed is each run's own CPU time). Returns the files written.
+/// `defaults` names the project's default settings (timestep, integrator, cone, links,
+/// base refinement) to highlight; `threads` runs at once (speed is each run's own CPU time). Returns the files written.
 pub fn run(
     scenario: &Path,
     grid: &Grid,
-    defaults: (f64, &str, &str, u32),
+    defaults: (f64, &str, &str, u32, u32),
     out: &Path,
     threads: usize,
 ) -> anyhow::Result<Vec<PathBuf>> {
@@ -130,12 +154,19 @@ pub fn run(
                     labels.push(Point::mujoco(dt, integrator, cone, segments));
                 }
             }
+            for &solver in &grid.solvers {
+                labels.push(Point { solver, ..Point::mujoco(dt, "implicitfast", "elliptic", segments) });
+            }
             if grid.rapier_timesteps_s.contains(&dt) && grid.rapier_segments.contains(&segments) {
                 labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
             }
         }
+        for &(segments, base_refinement) in &grid.graded {
+            labels.push(Point { base_refinement, ..Point::mujoco(dt, "implicitfast", "elliptic", segments) });
+        }
     }
-    let default = Point::mujoco(defaults.0, defaults.1, defaults.2, defaults.3);
+    let default =
+        Point { base_refinement: defaults.4, ..Point::mujoco(defaults.0, defaults.1, defaults.2, defaults.3) };
     let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), threads)?;
     let reference = &runs[0];
     let rows: Vec<SpeedAccuracyRow> = runs
@@ -152,8 +183,10 @@ pub fn run(
                 backend: r.summary.run.backend.clone(),
                 integrator: point.integrator.clone(),
                 cone: point.cone.clone(),
+                solver: point.solver.to_string(),
                 timestep_s: point.timestep_s,
                 segments: point.segments,
+                base_refinement: point.base_refinement,
                 sim_s_per_cpu_s: ok.then_some(r.summary.sim_s_per_cpu_s),
                 force_rmse_n: if i == 0 {
                     Some(0.0)
@@ -175,8 +208,10 @@ pub fn run(
         "backend",
         "integrator",
         "cone",
+        "solver",
         "timestep_s",
         "segments",
+        "base_refinement",
         "sim_s_per_cpu_s",
         "force_rmse_n",
         "drop_time_error_s",
@@ -191,8 +226,10 @@ pub fn run(
                 r.backend.clone(),
                 r.integrator.clone(),
                 r.cone.clone(),
+                r.solver.clone(),
                 r.timestep_s.to_string(),
                 r.segments.to_string(),
+                r.base_refinement.to_string(),
                 cell(r.sim_s_per_cpu_s),
                 cell(r.force_rmse_n),
                 cell(r.drop_time_error_s),

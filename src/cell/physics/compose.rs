@@ -1,6 +1,6 @@
 //! Assembles a scene's MJCF from the parts in models/ and the scenario's values.
 
-use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig};
+use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig, Solver};
 use super::object::ObjectModel;
 use super::template::{num, nums, render, section};
 use super::{PhysicsError, SceneSpec, ur5e};
@@ -83,9 +83,14 @@ pub fn header(p: &PhysicsConfig) -> String {
         Cone::Pyramidal => "pyramidal",
         Cone::Elliptic => "elliptic",
     };
+    let solver = match p.solver {
+        Solver::Newton => "Newton",
+        Solver::Cg => "CG",
+        Solver::Pgs => "PGS",
+    };
     format!(
         r#"<compiler angle="radian" autolimits="true"/>
-  <option timestep="{dt}" integrator="{integrator}" cone="{cone}" impratio="{imp}" solver="Newton"
+  <option timestep="{dt}" integrator="{integrator}" cone="{cone}" impratio="{imp}" solver="{solver}"
           iterations="{it}" tolerance="{tol}" ls_iterations="{ls}" noslip_iterations="{ns}"
           noslip_tolerance="{nstol}">
     <flag energy="enable" island="disable"/>

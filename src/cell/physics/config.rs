@@ -29,6 +29,19 @@ pub enum Cone {
     Elliptic,
 }
 
+/// MuJoCo's constraint solver (`<option solver>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Solver {
+    /// Newton's method on the primal problem: a Cholesky factorisation of the constraint Hessian
+    /// per iteration, few iterations.
+    Newton,
+    /// Conjugate gradient on the same primal problem: no factorisation, more iterations.
+    Cg,
+    /// Projected Gauss-Seidel on the dual problem.
+    Pgs,
+}
+
 /// Which engine simulates the scene (`physics.backend`). Both run the same scene, compiled once by
 /// MuJoCo from models/ (see [`super::rapier`] for how the rapier world is built from it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
@@ -191,7 +204,11 @@ pub struct PhysicsConfig {
     /// −0.1 %, and with the default 5 ms contacts at 1.25 ms, +0.02 %); 10, chosen earlier with 10 ms
     /// contacts to stop a held object creeping, needed 24 % more force there at 5 ms.
     pub impratio: f64,
-    /// Newton solver iterations (upper bound; it usually converges in 2-5).
+    /// Constraint solver. `newton`: converges in a few iterations to the tolerance below (the
+    /// convergence study's answers were measured with it); `cg` and `pgs` trade iterations for
+    /// cheaper ones, a numerical choice the speed-accuracy chart can weigh.
+    pub solver: Solver,
+    /// Solver iterations (upper bound; Newton usually converges in 2-5).
     pub iterations: u32,
     /// Solver tolerance (relative cost improvement). 1e-8: friction converged; tighter costs time for
     /// no measurable change in the validation results, and in the six Section V runs 1e-9 and 1e-10
@@ -247,6 +264,7 @@ impl Default for PhysicsConfig {
             integrator: Integrator::Implicitfast,
             cone: Cone::Elliptic,
             impratio: 3.0,
+            solver: Solver::Newton,
             iterations: 50,
             tolerance: 1e-8,
             ls_iterations: 20,

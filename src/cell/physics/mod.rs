@@ -28,7 +28,7 @@ pub mod validation;
 
 pub use compose::Placement;
 pub use config::{
-    ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig,
+    ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig, Solver,
 };
 pub use scene::{PhysicsReadout, Scene, SceneModel};
 
