@@ -117,10 +117,14 @@ struct SpeedAccuracy {
     rows: Vec<SpeedAccuracyRow>,
 }
 
-/// The colour series a row belongs to: its integrator, and its solver when that is not the
-/// default (Newton on MuJoCo, PGS on rapier).
+/// The colour series a row belongs to: its integrator, and on MuJoCo its solver when that is not
+/// the default Newton (rapier's integrator column already names its solver).
 fn series(r: &SpeedAccuracyRow) -> String {
-    if r.solver == "cg" { format!("{} + CG", r.integrator) } else { r.integrator.clone() }
+    if r.backend == "mujoco" && r.solver != "newton" {
+        format!("{} + {}", r.integrator, r.solver.to_uppercase())
+    } else {
+        r.integrator.clone()
+    }
 }
 
 /// Short description of a row's settings, for labels.
