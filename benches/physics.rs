@@ -69,12 +69,13 @@ fn physics(c: &mut Criterion) {
     let mut dynamic = SceneSpec::default();
     dynamic.physics.arm_mode = ArmMode::Dynamic;
     bench_scene(c, "full_scene_dynamic_arm_1s", dynamic);
-    // rapier at 32 links and a 5 ms step, the setting of README's rapier comparison: at the default
-    // 64 links and 1.25 ms it runs at about 0.1x real time.
+    // rapier at 32 uniform links and a 5 ms step, the setting of README's rapier comparison: at 64
+    // uniform links and 1.25 ms it runs at about 0.1x real time.
     let mut rapier = SceneSpec::default();
     rapier.physics.backend = Backend::Rapier;
     rapier.physics.timestep_s = 0.005;
     rapier.finger.segments = 32;
+    rapier.finger.base_refinement = 1;
     bench_scene(c, "full_scene_rapier_32links_5ms_1s", rapier);
 
     for (name, backend) in

@@ -12,14 +12,17 @@ use tendril::run::execute::{ModelCache, run_on_twin};
 use tendril::run::scenario::PickPlaceScenario;
 use tendril::scenario::Override;
 
-/// The shipped scenario on `backend`: MuJoCo at the converged default; rapier at 32 links and a
-/// 5 ms step, the setting of README's rapier comparison (at the default 64 links and 1.25 ms it
+/// The shipped scenario on `backend`: MuJoCo at the converged default; rapier at 32 uniform links
+/// and a 5 ms step, the setting of README's rapier comparison (at 64 uniform links and 1.25 ms it
 /// runs at about 0.1x real time, and `cargo test --all-targets` runs every bench once).
 fn scenario(name: &str, backend: Backend) -> PickPlaceScenario {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
     let mut overrides = vec![Override::backend(backend)];
     if backend == Backend::Rapier {
-        overrides.extend(["finger.segments=32", "physics.timestep_s=0.005"].map(|s| s.parse().expect("valid")));
+        overrides.extend(
+            ["finger.segments=32", "finger.base_refinement=1", "physics.timestep_s=0.005"]
+                .map(|s| s.parse().expect("valid")),
+        );
     }
     tendril::scenario::load(&file, &overrides).expect("shipped scenarios load")
 }

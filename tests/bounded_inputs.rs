@@ -75,6 +75,15 @@ fn the_defaults_and_the_shipped_scenarios_stay_valid() {
 }
 
 #[test]
+fn a_graded_finger_finer_than_its_bound_names_the_refinement_and_the_way_out() {
+    // 128 links on the default 8x finer base stretch: 1024 base links, past the 512 bound.
+    assert_eq!(key_of(&["finger.segments=128"]), "finger.base_refinement");
+    let err = load(&["finger.segments=128"]).unwrap_err().to_string();
+    assert!(err.contains("128 x 8 = 1024") && err.contains("base_refinement = 1"), "{err}");
+    assert!(load(&["finger.segments=128", "finger.base_refinement=1"]).is_ok());
+}
+
+#[test]
 fn any_u64_seed_is_accepted_through_set_and_the_file() {
     assert_eq!(load(&["seed=18446744073709551615"]).unwrap().seed, u64::MAX);
     assert_eq!(load(&["seed=\"18446744073709551615\""]).unwrap().seed, u64::MAX);

@@ -50,7 +50,7 @@ fn a_steady_grip_under_thirty_picometres_of_noise_raises_no_alarm() {
 fn without_feedback_the_pad_loses_the_crimper_seconds_before_it_falls() {
     // The object then hangs on the palm's pinch (models/README.md): the sensor's loss is a false
     // alarm by the ground truth, and the drop itself is not seen. On the converged default the pad
-    // lets go 1.6 s before the crimper falls (seed 1: alarm 8.37 s, drop 9.96 s; 4-8 s on the
+    // lets go 2.2 s before the crimper falls (seed 1: alarm 7.83 s, drop 9.98 s; 4-8 s on the
     // coarser 32-link finger).
     let s = run("crimper", &["feedback=false"]);
     assert_eq!(s.outcome, "dropped");

@@ -78,7 +78,7 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         emit(&format!("stopped by {}: {} runs finished and written\n", crate::interrupt::name(signal), stats.ran));
     }
     emit(&format!(
-        "{} runs in this sweep{}: {} run now ({} errors), {} already done; {:.0} simulated s in {:.1} s wall ({:.0}x real time)\nwrote {}\n",
+        "{} runs in this sweep{}: {} run now ({} errors), {} already done; {:.0} simulated s in {:.1} s wall ({}x real time)\nwrote {}\n",
         stats.planned,
         a.shard.map_or(String::new(), |s| format!(" shard {}/{}", s.index, s.count)),
         stats.ran,
@@ -86,7 +86,7 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         stats.skipped,
         stats.sim_time_s,
         stats.wall_time_s,
-        stats.sim_time_s / stats.wall_time_s.max(1e-9),
+        crate::run::summary::speed_factor(stats.sim_time_s / stats.wall_time_s.max(1e-9)),
         stats.results.display()
     ));
     Ok(super::exit_for_runs(stats.errors > 0))

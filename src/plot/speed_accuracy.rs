@@ -286,9 +286,19 @@ impl Chart for SpeedAccuracy {
                 .legend(|(x, y)| Cross::new((x + 10, y), 6, style::BAD.stroke_width(2)));
         }
 
-        let note = |text: String, at: (f64, f64), v: VPos| -> DrawResult {
-            let font = TextStyle::from((FONT, style::SMALL).into_font()).pos(Pos::new(HPos::Left, v));
-            chart.plotting_area().draw(&Text::new(text, at, font))?;
+        // A label goes right of its point in the chart's left 60 % (log speed) and left of it
+        // beyond, so that the fastest points' labels stay inside the plot; `gap` is the factor in
+        // speed between the point and the label's near end.
+        let (x_lo, x_hi) = ((s_lo / 2.0).ln(), (s_hi * 2.0).ln());
+        let note = |text: String, (s, e): (f64, f64), gap: f64, v: VPos| -> DrawResult {
+            let left_side = (s.ln() - x_lo) / (x_hi - x_lo) < 0.6;
+            let (h, at, text) = if left_side {
+                (HPos::Left, s * gap, format!("  {text}"))
+            } else {
+                (HPos::Right, s / gap, format!("{text}  "))
+            };
+            let font = TextStyle::from((FONT, style::SMALL).into_font()).pos(Pos::new(h, v));
+            chart.plotting_area().draw(&Text::new(text, (at, e), font))?;
             Ok(())
         };
         for i in &front {
@@ -297,7 +307,7 @@ impl Chart for SpeedAccuracy {
                 continue; // labelled below as the default
             }
             if let Some((s, e)) = plottable(r) {
-                note(format!("  {}", settings(r)), (s * 1.08, e), VPos::Top)?;
+                note(settings(r), (s, e), 1.08, VPos::Top)?;
             }
         }
         for r in self.rows.iter().filter(|r| r.is_reference) {
@@ -306,13 +316,13 @@ impl Chart for SpeedAccuracy {
             let e = plottable(r).map_or(y_lo * 1.4, |p| p.1);
             chart.plotting_area().draw(&TriangleMarker::new((s, e), 10, BLACK.filled()))?;
             let zero = if plottable(r).is_none() { ", zero error by definition" } else { "" };
-            let text = format!("  reference: {} ({}){zero}", settings(r), r.integrator);
-            note(text, (s * 1.05, e), VPos::Center)?;
+            let text = format!("reference: {} ({}){zero}", settings(r), r.integrator);
+            note(text, (s, e), 1.05, VPos::Center)?;
         }
         for r in self.rows.iter().filter(|r| r.is_default) {
             if let Some((s, e)) = plottable(r) {
                 chart.plotting_area().draw(&Circle::new((s, e), 15, BLACK.stroke_width(3)))?;
-                note(format!("  default: {} ({})", settings(r), r.integrator), (s * 1.12, e), VPos::Bottom)?;
+                note(format!("default: {} ({})", settings(r), r.integrator), (s, e), 1.12, VPos::Bottom)?;
             }
         }
         chart

@@ -208,8 +208,34 @@ pub fn render_text(s: &RunSummary) -> String {
     }
     out += &format!("  estimate RMSE      {}\n", opt(s.metrics.force_rmse_n, "N"));
     out += &format!(
-        "  simulated {:.1} s in {:.2} s wall ({:.0}x real time), {:.2} s of CPU ({:.0}x)\n",
-        s.sim_time_s, s.wall_time_s, s.real_time_factor, s.cpu_time_s, s.sim_s_per_cpu_s
+        "  simulated {:.1} s in {:.2} s wall ({}x real time), {:.2} s of CPU ({}x)\n",
+        s.sim_time_s,
+        s.wall_time_s,
+        speed_factor(s.real_time_factor),
+        s.cpu_time_s,
+        speed_factor(s.sim_s_per_cpu_s)
     );
     out
+}
+
+/// A speed ratio (simulated s per s) to two significant figures, so that a slow backend's 0.35x
+/// does not print as 0x: 120, 21, 8.3, 0.35.
+pub fn speed_factor(x: f64) -> String {
+    match x.abs() {
+        a if a >= 10.0 || a == 0.0 || !a.is_finite() => format!("{x:.0}"),
+        a if a >= 1.0 => format!("{x:.1}"),
+        a if a >= 0.1 => format!("{x:.2}"),
+        _ => format!("{x:.1e}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::speed_factor;
+
+    #[test]
+    fn speed_factors_keep_two_significant_figures() {
+        let printed: Vec<String> = [120.4, 21.3, 8.27, 0.347, 0.0123, 0.0].map(speed_factor).into();
+        assert_eq!(printed, ["120", "21", "8.3", "0.35", "1.2e-2", "0"]);
+    }
 }

@@ -44,8 +44,9 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// The full study (about a hundred runs) around the converged default (1.25 ms, 64 links): the
-    /// step halved and doubled twice, the links halved and doubled, against the convergence
+    /// The full study (about 130 runs): uniform fingers around the 64 links the uniform grid
+    /// converges at, halved and doubled, and graded fingers (the default, 8 links with a base
+    /// stretch 8x finer, among them), each at a step of 0.625-5 ms, against the convergence
     /// study's finest setting.
     pub fn full() -> Grid {
         Grid {

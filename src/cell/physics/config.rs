@@ -175,8 +175,8 @@ pub enum ArmMode {
 /// Defaults are the converged setting (README, "Convergence"): elliptic cones and a Newton solver with
 /// a small tolerance (MuJoCo's advice for slip accuracy; modeling.md measured that pyramidal cones
 /// creep), stiff contacts that hold objects without noslip iterations, and the largest step at which
-/// the Section V answers agree with half that step. About 8x real time on one core
-/// (benches/scenario.rs; README, "Speed and accuracy").
+/// the Section V answers agree with half that step. About 20x real time on one core with the default
+/// graded finger (benches/scenario.rs; README, "Speed and accuracy").
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
@@ -330,16 +330,21 @@ impl Validate for PhysicsConfig {
 #[serde(deny_unknown_fields, default)]
 pub struct FingerConfig {
     /// Number of strip segments (discretisation; the pad's casing and the tip's anchor are single
-    /// rigid pieces at any number, `strip::layout`). 64: 2.2 mm links, about 38 per turn around a
-    /// 12.5 mm-radius handle, the coarsest finger whose drop times agree with 128 links within 0.5 s
-    /// (README, "Convergence"; at 32 links the drops came 1.6-2.0 s later than at 64, at 16 links
-    /// later still). A numerical choice, not a calibration knob.
+    /// rigid pieces at any number, `strip::layout`). 8, with `base_refinement` 8: 17.5 mm links
+    /// from the pad to the tip and 2.2 mm links from the strip's base to the pad, 30 bodies in all.
+    /// Its answers agree with 16 and 32 links and with a quarter of the step by the convergence
+    /// criteria in 76 of 90 comparisons, and with the uniform 64-link finger's drop times within
+    /// 0.2 s, at 2.5 times its speed (README, "Convergence"; `docs/convergence/`). An object much
+    /// smaller than the paper's (a wrap of under ~4 links per turn) should be checked at links x2
+    /// (`tendril chart convergence --quick`). A numerical choice, not a calibration knob.
     pub segments: u32,
     /// How many times finer than `segments` implies the links are between the strip's base and the
     /// pad's casing (1: a uniform grid). A numerical choice, like `segments`: that stretch holds the
     /// pinch between palm and strip where the wrap starts, which carries most of an object held
     /// without feedback and converges only at first order in the link length there (models/README.md,
-    /// "What still moves with the links"); doubling `segments` halves both grids.
+    /// "What still moves with the links"), so it gets the 2.2 mm links the uniform finger needed
+    /// there, while the distal stretch, whose loads change slowly, keeps coarse ones. Doubling
+    /// `segments` halves both grids.
     pub base_refinement: u32,
     /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
@@ -447,8 +452,8 @@ pub struct FingerConfig {
 impl Default for FingerConfig {
     fn default() -> Self {
         FingerConfig {
-            segments: 64,
-            base_refinement: 1,
+            segments: 8,
+            base_refinement: 8,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,
@@ -483,14 +488,25 @@ impl FingerConfig {
 
 impl Validate for FingerConfig {
     fn validate(&self, at: &mut Checker) {
-        // 256: the convergence study's links x4 from the 64-link default (0.55 mm segments on a 14 cm
-        // strip, a quarter of the strip's 2 mm thickness; nothing finer describes the strip better).
+        // 256: 0.55 mm segments on a 14 cm strip, a quarter of the strip's 2 mm thickness; nothing
+        // finer describes the strip better (the convergence study's finest uniform finger).
         at.require("segments", (2..=256).contains(&self.segments), || {
             format!("must be between 2 and 256, got {}", self.segments)
         });
-        // 8: the base stretch's links are then 0.27 mm at 64 links, an eighth of the strip's thickness.
+        // 8: at the default 8 links the base stretch's links are then 2.2 mm, the uniform finger's
+        // converged length; more than 8 would only matter at fewer than 8 links.
         at.require("base_refinement", (1..=8).contains(&self.base_refinement), || {
             format!("must be between 1 and 8, got {}", self.base_refinement)
+        });
+        // 512: base links of 0.27 mm, an eighth of the strip's thickness (and about 230 bodies in the
+        // base stretch alone); finer only slows the run down.
+        let base_links = self.segments.saturating_mul(self.base_refinement);
+        at.require("base_refinement", base_links <= 512, || {
+            format!(
+                "segments x base_refinement must be at most 512 (base links of 0.27 mm), got {} x {} = {base_links}; \
+                 for a uniform finger of {} links set base_refinement = 1",
+                self.segments, self.base_refinement, self.segments
+            )
         });
         at.in_range("length_m", self.length_m, 0.02, 0.5);
         at.in_range("thickness_m", self.thickness_m, 2e-4, 0.02);
