@@ -1,10 +1,12 @@
 //! Simulation speed of the physics scenes, reported as time per simulated second: the real-time factor
 //! is 1 / (that time in seconds). `cargo bench --bench physics`.
 //!
-//! - `full_scene_kinematic_1s`: the pick-and-place scene with default settings (kinematic arm, 10-segment
-//!   finger with the pad, crimper, table), already grasped, lifting the hand 5 cm in the measured second.
+//! - `full_scene_kinematic_1s`: the pick-and-place scene with default settings (kinematic arm, the
+//!   default finger with the pad, crimper, table), already grasped, lifting the hand 5 cm in the
+//!   measured second.
 //! - `full_scene_dynamic_arm_1s`: the same with the six-joint arm dynamics.
-//! - `full_scene_rapier_1s`: the kinematic-arm scene on the rapier backend.
+//! - `full_scene_rapier_32links_5ms_1s`: the kinematic-arm scene on the rapier backend (32 uniform
+//!   links, 5 ms; see below).
 //! - `minimal_box_on_plane_1s` (and `_rapier_1s`): a box resting on a plane with the same options.
 
 use criterion::{Criterion, criterion_group, criterion_main};
