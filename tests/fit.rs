@@ -90,26 +90,11 @@ fn a_fit_from_the_defaults_recovers_the_recorded_cell_and_its_overlay_reproduces
     // closely (another seed than the fit's).
     record(&dir.path().join("held-out"), "on", &["--seed", "5"]);
     let replay = dir.path().join("replay");
-    let o = tendril(&[
-        "run",
-        SCENARIO,
-        "--feedback",
-        "on",
-        "--seed",
-        "5",
-        "--set",
-        "task.lift_s=10",
-        "--set",
-        "finger.segments=32",
-        "--set",
-        "finger.base_refinement=1",
-        "--set",
-        "physics.timestep_s=0.005",
-        "--overlay",
-        out.join("overlay.toml").to_str().unwrap(),
-        "--out",
-        replay.to_str().unwrap(),
-    ]);
+    let overlay = out.join("overlay.toml");
+    let mut args = vec!["run", SCENARIO, "--feedback", "on", "--seed", "5"];
+    args.extend(LONG_LIFT.iter().chain(&QUICK_NUMERICS));
+    args.extend(["--overlay", overlay.to_str().unwrap(), "--out", replay.to_str().unwrap()]);
+    let o = tendril(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let tau = best(&report, "finger.relaxation_time_s");
     let effective = std::fs::read_to_string(replay.join("scenario.toml")).unwrap();
