@@ -1,11 +1,11 @@
 //! Simulation speed of the physics scenes, reported as time per simulated second: the real-time factor
 //! is 1 / (that time in seconds). `cargo bench --bench physics`.
 //!
-//! - `full_scene_kinematic_1s`: the pick-and-place scene with default settings (kinematic arm, the
-//!   default finger with the pad, crimper, table), already grasped, lifting the hand 5 cm in the
-//!   measured second.
-//! - `full_scene_dynamic_arm_1s`: the same with the six-joint arm dynamics.
-//! - `full_scene_rapier_32links_5ms_1s`: the kinematic-arm scene on the rapier backend (32 uniform
+//! - `full_scene_1s`: the pick-and-place scene with default settings (the servoed arm, the default
+//!   finger with the pad, crimper, table), already grasped, lifting the hand 5 cm in the measured
+//!   second.
+//! - `full_scene_kinematic_arm_1s`: the same with the arm's motion prescribed.
+//! - `full_scene_rapier_32links_5ms_1s`: the prescribed-arm scene on the rapier backend (32 uniform
 //!   links, 5 ms; see below).
 //! - `minimal_box_on_plane_1s` (and `_rapier_1s`): a box resting on a plane with the same options.
 
@@ -67,14 +67,15 @@ fn bench_scene(c: &mut Criterion, name: &str, spec: SceneSpec) {
 }
 
 fn physics(c: &mut Criterion) {
-    bench_scene(c, "full_scene_kinematic_1s", SceneSpec::default());
-    let mut dynamic = SceneSpec::default();
-    dynamic.physics.arm_mode = ArmMode::Dynamic;
-    bench_scene(c, "full_scene_dynamic_arm_1s", dynamic);
+    bench_scene(c, "full_scene_1s", SceneSpec::default());
+    let mut kinematic = SceneSpec::default();
+    kinematic.physics.arm_mode = ArmMode::Kinematic;
+    bench_scene(c, "full_scene_kinematic_arm_1s", kinematic);
     // rapier at 32 uniform links and a 5 ms step, the setting of README's rapier comparison: at 64
     // uniform links and 1.25 ms it runs at about 0.1x real time.
     let mut rapier = SceneSpec::default();
     rapier.physics.backend = Backend::Rapier;
+    rapier.physics.arm_mode = ArmMode::Kinematic;
     rapier.physics.timestep_s = 0.005;
     rapier.finger.segments = 32;
     rapier.finger.base_refinement = 1;
@@ -83,7 +84,7 @@ fn physics(c: &mut Criterion) {
     for (name, backend) in
         [("minimal_box_on_plane_1s", Backend::Mujoco), ("minimal_box_on_plane_rapier_1s", Backend::Rapier)]
     {
-        let p = PhysicsConfig { backend, ..PhysicsConfig::default() };
+        let p = PhysicsConfig { backend, arm_mode: backend.default_arm_mode(), ..PhysicsConfig::default() };
         let model = std::sync::Arc::new(validation::box_on_plane(&p).expect("builds"));
         c.bench_function(name, |b| {
             b.iter(|| {

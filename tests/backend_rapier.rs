@@ -17,6 +17,7 @@ fn run_with_backend_rapier_names_it_in_the_summary() {
     let summary: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["backend"], "rapier");
+    assert_eq!(summary["effective_scenario"]["physics"]["arm_mode"], "kinematic", "rapier's only arm");
     assert_eq!(summary["outcome"], "held", "{summary:#}");
     assert!(summary["sim_time_s"].as_f64().unwrap() > 5.0);
 }

@@ -165,6 +165,16 @@ fn unbounded_arguments_are_refused_at_once() {
     }
 }
 
+/// A missing file is named once with its reason, not with the reason repeated as its cause.
+#[test]
+fn a_missing_scenario_says_why_once() {
+    let out = tendril(&["run", "no/such/scenario.toml"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("no/such/scenario.toml: cannot read"), "{err}");
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+}
+
 #[test]
 fn a_scenario_name_cannot_write_outside_out() {
     let dir = tempfile::tempdir().unwrap();

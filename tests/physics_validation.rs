@@ -48,13 +48,14 @@ both_backends!(
 );
 
 /// MuJoCo at its defaults. rapier at 5 ms: at a 1.25 ms step with 64 uniform links it runs at
-/// about 0.1x real time, too slow for these checks in CI (README, "The rapier backend").
+/// about 0.1x real time, too slow for these checks in CI (README, "The rapier backend"); and with
+/// its prescribed arm, the only one it has.
 fn physics(backend: Backend) -> PhysicsConfig {
     let timestep_s = match backend {
         Backend::Mujoco => PhysicsConfig::default().timestep_s,
         Backend::Rapier => 0.005,
     };
-    PhysicsConfig { backend, timestep_s, ..PhysicsConfig::default() }
+    PhysicsConfig { backend, timestep_s, arm_mode: backend.default_arm_mode(), ..PhysicsConfig::default() }
 }
 
 /// The scene at [`physics`]; rapier's finger at 32 uniform links (see there).
@@ -392,7 +393,8 @@ const ARM_TARGET: [f64; 6] = [-1.5, -1.7, 1.8, -1.7, -1.57, 0.0];
 /// rapier, whose world is placed joint by joint from the same chain); moving, it follows a new target
 /// within 2 mm once settled.
 fn kinematic_arm_puts_the_hand_where_dh_kinematics_says(backend: Backend) {
-    let spec = SceneSpec { object: None, arm_q0: ARM_START, ..spec(backend) };
+    let mut spec = SceneSpec { object: None, arm_q0: ARM_START, ..spec(backend) };
+    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Kinematic;
     let mut s = SceneModel::build(&spec).unwrap().start().unwrap();
     let at_start = if backend == Backend::Mujoco { 1e-9 } else { 1e-6 };
     let err = hand_error_m(s.as_ref(), &ARM_START);

@@ -104,7 +104,7 @@ pub fn main() -> ExitCode {
     let code = match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("tendril: {e:#}");
+            eprintln!("tendril: {}", error_chain(&e));
             return ExitCode::FAILURE;
         }
     };
@@ -174,4 +174,22 @@ fn exit_for_runs(any_error: bool) -> ExitCode {
 /// Exit code for a list of pass/fail verdicts: success only when all pass.
 fn exit_all(pass: bool) -> ExitCode {
     if pass { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+}
+
+/// `error: cause: cause ...`, leaving out a cause whose text the message before it already ends
+/// with (errors that print their source in their own message, as `{file}: cannot read: {source}`
+/// does, would otherwise say it twice).
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let cause = cause.to_string();
+        if text.ends_with(&cause) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&cause);
+    }
+    text
 }

@@ -330,6 +330,15 @@ impl TaskSequencer {
         }
     }
 
+    /// The pose the arm holds in a phase without a move \[rad\]: home until the lift, the place
+    /// pose after the lowering.
+    fn held_pose(&self) -> [f64; ARM_JOINTS] {
+        match self.phase {
+            Phase::Home | Phase::Grow | Phase::Wrap | Phase::Grasp => radians(&self.task.home_deg),
+            _ => radians(&self.task.place_deg),
+        }
+    }
+
     /// The arm's move for `phase` (lift, transfer or lower) from `arm_q` \[rad\], if it has one.
     fn plan_move(&self, phase: Phase, arm_q: [f64; ARM_JOINTS]) -> Option<JointMove> {
         let t = &self.task;
@@ -384,16 +393,18 @@ impl TaskSequencer {
             _ => None,
         };
         if let Some(phase) = next {
-            // Chain moves from the planned end pose, not the measured one, so small tracking
-            // errors do not accumulate into the plan.
-            self.enter(phase, now, arm_target.unwrap_or(state.arm_q));
+            // Chain moves from the commanded pose (the planned end, or the pose held), not the
+            // measured one: small tracking errors do not accumulate into the plan, and a servoed arm
+            // that sags under its payload (`physics.arm_mode = "dynamic"`: 1.5 mrad at the shoulder)
+            // is not sent a step to its sagged pose when the lift starts.
+            let from = arm_target.unwrap_or_else(|| self.held_pose());
+            self.enter(phase, now, from);
         }
         let elapsed = now - self.phase_start_s;
 
-        let arm_q = match (&self.arm_move, self.phase) {
-            (Some(m), _) => m.sample(elapsed).0,
-            (None, Phase::Home | Phase::Grow | Phase::Wrap | Phase::Grasp) => radians(&self.task.home_deg),
-            (None, _) => radians(&self.task.place_deg),
+        let arm_q = match &self.arm_move {
+            Some(m) => m.sample(elapsed).0,
+            None => self.held_pose(),
         };
 
         let mut controller_output = 0.0;

@@ -7,6 +7,7 @@
 //! [`Overlay`] (`--overlay FILE`, what `tendril fit` and `tendril tune` write) is a file of such
 //! overrides, applied before the command line's.
 
+mod backend_defaults;
 mod magnitude;
 mod overlay;
 mod overrides;
@@ -109,6 +110,7 @@ pub fn from_table<T: DeserializeOwned + Validate>(mut table: toml::Table, file: 
     }
     paths::resolve_models(&mut table, file);
     paths::resolve_object(&mut table, file);
+    backend_defaults::fill_backend_defaults(&mut table);
     let value: T = serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let path = e.path().to_string();
         // The TOML layer appends "in `key`" lines; the key is reported separately.

@@ -62,6 +62,16 @@ impl Backend {
             Backend::Rapier => "rapier",
         }
     }
+
+    /// The arm mode a scenario gets on this backend when it does not set `physics.arm_mode`: the
+    /// servoed UR5e on MuJoCo (see [`ArmMode::Dynamic`] for why), the prescribed arm on rapier,
+    /// which has no other.
+    pub fn default_arm_mode(self) -> ArmMode {
+        match self {
+            Backend::Mujoco => ArmMode::Dynamic,
+            Backend::Rapier => ArmMode::Kinematic,
+        }
+    }
 }
 
 impl std::str::FromStr for Backend {
@@ -156,18 +166,41 @@ impl Validate for RapierConfig {
     }
 }
 
-/// How the UR5e is simulated.
+/// How the UR5e is simulated (`physics.arm_mode`). Not set in a scenario: the backend's
+/// [`Backend::default_arm_mode`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ArmMode {
     /// Prescribed arm motion: each step the six joints get the velocities that take them to the
     /// commanded angles (rate-limited to `arm_max_speed_rad_s`), so the hand moves along the UR's
     /// trajectory and has the velocity friction needs (a mocap body would have none). The joints
-    /// carry a large armature so contact forces do not move the arm within a step. The UR's own servo
-    /// loop is stiff enough that the real hand follows its trajectory too. Cheapest (no servos).
+    /// carry a large armature so contact forces do not move the arm within a step.
+    ///
+    /// On MuJoCo its answers need a finer step than the default's: while the arm moves, the wrap's
+    /// contacts chatter tick to tick at 1.25 ms (the pad force by 0.028 N RMS against 0.0002 N with
+    /// the dynamic arm), the frozen grip relaxes faster and the shampoo without feedback drops
+    /// 0.85 s early. The chatter grows with the armature (the shampoo's drop 13.9 / 13.0 / 11.9 s at
+    /// 100 / 1000 / 10 000 kg m^2) and is gone at 0.3125 ms, where the drop is the dynamic arm's
+    /// (README, "Convergence"). The only mode of the rapier backend.
     Kinematic,
-    /// The six joints with masses, gravity compensation and position servos (models/ur5e.xml).
+    /// The six joints with masses, gravity compensation and position servos (models/ur5e.xml). The
+    /// servos track the same setpoints the prescribed arm moves along (each tick's target spread
+    /// over the tick), with the setpoint's velocity fed forward, as the UR's own joint controller
+    /// tracks its interpolated trajectory; the hand gives way to contact forces through the servos'
+    /// stiffness. MuJoCo's default: its answers hold from 2.5 ms down (the shampoo's drop without
+    /// feedback 13.73 / 13.89 / 13.94 s at 2.5 / 1.25 / 0.625 ms, seed 1) for about 5 % more time
+    /// per step than the prescribed arm.
     Dynamic,
+}
+
+impl ArmMode {
+    /// The name as written in scenarios (`kinematic`, `dynamic`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ArmMode::Kinematic => "kinematic",
+            ArmMode::Dynamic => "dynamic",
+        }
+    }
 }
 
 /// `[physics]`: MuJoCo options and the divergence bounds.
@@ -238,10 +271,13 @@ pub struct PhysicsConfig {
     pub contact_dampratio: f64,
     /// Contact solimp (d0, dwidth, width \[m\]): impedance 0.95 -> 0.99 over 1 mm of penetration.
     pub contact_solimp: [f64; 3],
-    /// Arm simulation mode (`kinematic` | `dynamic`).
+    /// Arm simulation mode (`kinematic` | `dynamic`). Not set: `dynamic` on MuJoCo, `kinematic` on
+    /// rapier ([`Backend::default_arm_mode`]; the scenario loader fills it in, so summaries record
+    /// the mode a run used).
     pub arm_mode: ArmMode,
-    /// Kinematic mode: the largest joint speed the commanded targets are followed with [rad/s]; UR5e
-    /// maximum 180 deg/s (hardware.md). Targets further away are approached at this speed.
+    /// The largest joint speed the commanded targets are followed with [rad/s] (the prescribed
+    /// arm's speed, the servos' setpoints'); UR5e maximum 180 deg/s (hardware.md). Targets further
+    /// away are approached at this speed.
     pub arm_max_speed_rad_s: f64,
     /// Divergence bound: deepest allowed contact penetration \[m\]. 30 mm: a dropped object falls
     /// through the finger or onto the table at up to ~1.5 m/s (a 12 cm fall), and soft contacts let it
@@ -273,7 +309,7 @@ impl Default for PhysicsConfig {
             contact_timeconst_s: 0.005,
             contact_dampratio: 1.0,
             contact_solimp: [0.95, 0.99, 0.001],
-            arm_mode: ArmMode::Kinematic,
+            arm_mode: Backend::Mujoco.default_arm_mode(),
             arm_max_speed_rad_s: std::f64::consts::PI,
             max_penetration_m: 0.03,
             max_kinetic_energy_j: 200.0,
@@ -313,8 +349,8 @@ impl Validate for PhysicsConfig {
         at.in_range("max_kinetic_energy_j", self.max_kinetic_energy_j, 1e-6, 1e6);
         at.section("rapier", &self.rapier);
         at.require("arm_mode", !(self.backend == Backend::Rapier && self.arm_mode == ArmMode::Dynamic), || {
-            "the dynamic arm (UR5e servos) is MuJoCo-only; the rapier backend prescribes the arm's motion \
-             (arm_mode = \"kinematic\")"
+            "the dynamic arm (UR5e servos) is MuJoCo-only; the rapier backend prescribes the arm's motion: \
+             set arm_mode = \"kinematic\" or leave it out"
                 .into()
         });
     }

@@ -1,6 +1,7 @@
 //! What every physics backend does the same way between the cell's commands and its solver: the
-//! motors' speed limit, the kinematic arm's interpolation between control ticks, and the object's
-//! position and slip relative to the hand.
+//! motors' speed limit, the arm's interpolation between control ticks (the prescribed arm moves
+//! along it, the servoed arm's setpoints follow it), and the object's position and slip relative to
+//! the hand.
 
 use super::PhysicsError;
 use super::config::{FingerConfig, PhysicsConfig};
@@ -14,7 +15,7 @@ pub struct Drive {
     /// The servos' current setpoints [m]: they move towards the targets at the motor speed.
     motor_setpoint: [f64; 2],
     arm_target: [f64; 6],
-    /// The kinematic arm's current angles [rad] (the rate-limited commanded angles).
+    /// The arm's current setpoint angles [rad] (the rate-limited commanded angles).
     arm_q: [f64; 6],
     /// Simulated time of the latest arm command and the interval since the one before [s]; the
     /// move to a new target is spread over that interval (see [`Drive::advance`]).
@@ -31,7 +32,7 @@ pub struct Drive {
 pub struct StepSetpoints {
     /// Growth and twine servo setpoints \[m\].
     pub motors: [f64; 2],
-    /// Kinematic arm angles at the end of the step \[rad\].
+    /// Arm setpoint angles at the end of the step \[rad\].
     pub arm_q: [f64; 6],
 }
 
@@ -86,7 +87,7 @@ impl Drive {
         self.arm_target
     }
 
-    /// The kinematic arm's current angles \[rad\].
+    /// The arm's current setpoint angles \[rad\].
     pub fn arm_q(&self) -> [f64; 6] {
         self.arm_q
     }
@@ -99,7 +100,7 @@ impl Drive {
     /// Advances the setpoints over the step that starts at `t0_s` and lasts `dt_s`.
     ///
     /// Motors: each setpoint moves towards its target by at most the motor speed times the step.
-    /// Kinematic arm: a controller commands a new target every control tick (several steps); the
+    /// Arm: a controller commands a new target every control tick (several steps); the
     /// remaining way is spread evenly over the steps left until the next command is due, so the
     /// hand moves at the commanded velocity. Jumping to each target in one step and then standing
     /// still shook the hand at the control rate (at 100 Hz during the transfer, ±0.15 m/s every

@@ -205,8 +205,9 @@ pub fn open_bus(
 /// `before` and `after` (time \[s\], joints \[rad\]), `t` clamped to the span between them.
 ///
 /// Why: the physics moves the arm once per step (5 ms), so reporting the latest step gave a 500 Hz
-/// client the same sample in two or three packages running. The kinematic arm moves at a constant
-/// rate within a step, so the interpolation is the arm's actual path. The physics steps once a
+/// client the same sample in two or three packages running. Within a step (1.25 ms) the arm moves
+/// at nearly a constant rate (exactly so with `physics.arm_mode = "kinematic"`; the servoed arm's
+/// speed changes by a step's acceleration), so the interpolation is its path. The physics steps once a
 /// tick's wait passes half of the step (`wait_until`), so the latest step ends within half a step
 /// of the twin's clock either way; at half a step behind the clock the sample is always between
 /// the last two steps: an interpolation, never an extrapolation. The cost: RTDE's samples are half a
@@ -282,8 +283,8 @@ pub fn spawn(
             twine_motor_rad: first.twine_motor_rad,
         };
         // The physics moves the arm once per step (several twin ticks): the joint velocities are
-        // the last step's displacement over its duration (the kinematic arm moves at a constant
-        // rate within a step), held until the next step changes them.
+        // the last step's displacement over its duration (the arm moves at nearly a constant rate
+        // within a step), held until the next step changes them.
         let mut last_step = (first.time_s, first.arm_q, [first.growth_motor_rad, first.twine_motor_rad]);
         // The arm at the step before: RTDE reports the arm interpolated between the two.
         let mut step_before = (first.time_s, first.arm_q);
