@@ -187,9 +187,9 @@ pub enum ArmMode {
     /// servos track the same setpoints the prescribed arm moves along (each tick's target spread
     /// over the tick), with the setpoint's velocity fed forward, as the UR's own joint controller
     /// tracks its interpolated trajectory; the hand gives way to contact forces through the servos'
-    /// stiffness. MuJoCo's default: its answers hold from 2.5 ms down (the shampoo's drop without
-    /// feedback 13.73 / 13.89 / 13.94 s at 2.5 / 1.25 / 0.625 ms, seed 1) for about 5 % more time
-    /// per step than the prescribed arm.
+    /// stiffness. MuJoCo's default: its answers hold from the default step down (the shampoo's drop
+    /// without feedback 13.83 / 13.90 / 13.91 s at 1.25 / 0.625 / 0.3125 ms, seed 1; README,
+    /// "Convergence") for about 5 % more time per step than the prescribed arm.
     Dynamic,
 }
 
@@ -369,7 +369,7 @@ pub struct FingerConfig {
     /// rigid pieces at any number, `strip::layout`). 8, with `base_refinement` 8: 17.5 mm links
     /// from the pad to the tip and 2.2 mm links from the strip's base to the pad, 30 bodies in all.
     /// Its answers agree with 16 and 32 links and with a quarter of the step by the convergence
-    /// criteria in 76 of 90 comparisons, and with the uniform 64-link finger's drop times within
+    /// criteria in 85 of 90 comparisons, and with the uniform 64-link finger's drop times within
     /// 0.2 s, at 2.5 times its speed (README, "Convergence"; `docs/convergence/`). An object much
     /// smaller than the paper's (a wrap of under ~4 links per turn) should be checked at links x2
     /// (`tendril chart convergence --quick`). A numerical choice, not a calibration knob.
