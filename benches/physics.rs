@@ -73,10 +73,10 @@ fn physics(c: &mut Criterion) {
     bench_scene(c, "full_scene_kinematic_arm_1s", kinematic);
     // rapier at 32 uniform links and a 5 ms step, the setting of README's rapier comparison: at 64
     // uniform links and 1.25 ms it runs at about 0.1x real time.
-    let mut rapier = SceneSpec::default();
-    rapier.physics.backend = Backend::Rapier;
-    rapier.physics.arm_mode = ArmMode::Kinematic;
-    rapier.physics.timestep_s = 0.005;
+    let mut rapier = SceneSpec {
+        physics: PhysicsConfig { timestep_s: 0.005, ..PhysicsConfig::on(Backend::Rapier) },
+        ..SceneSpec::default()
+    };
     rapier.finger.segments = 32;
     rapier.finger.base_refinement = 1;
     bench_scene(c, "full_scene_rapier_32links_5ms_1s", rapier);
@@ -84,7 +84,7 @@ fn physics(c: &mut Criterion) {
     for (name, backend) in
         [("minimal_box_on_plane_1s", Backend::Mujoco), ("minimal_box_on_plane_rapier_1s", Backend::Rapier)]
     {
-        let p = PhysicsConfig { backend, arm_mode: backend.default_arm_mode(), ..PhysicsConfig::default() };
+        let p = PhysicsConfig::on(backend);
         let model = std::sync::Arc::new(validation::box_on_plane(&p).expect("builds"));
         c.bench_function(name, |b| {
             b.iter(|| {

@@ -55,7 +55,7 @@ fn physics(backend: Backend) -> PhysicsConfig {
         Backend::Mujoco => PhysicsConfig::default().timestep_s,
         Backend::Rapier => 0.005,
     };
-    PhysicsConfig { backend, timestep_s, arm_mode: backend.default_arm_mode(), ..PhysicsConfig::default() }
+    PhysicsConfig { timestep_s, ..PhysicsConfig::on(backend) }
 }
 
 /// The scene at [`physics`]; rapier's finger at 32 uniform links (see there).

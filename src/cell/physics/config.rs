@@ -292,6 +292,14 @@ pub struct PhysicsConfig {
     pub rapier: RapierConfig,
 }
 
+impl PhysicsConfig {
+    /// The defaults on `backend`, with the arm mode a scenario naming only that backend gets
+    /// ([`Backend::default_arm_mode`]); for configurations built in code rather than loaded.
+    pub fn on(backend: Backend) -> PhysicsConfig {
+        PhysicsConfig { backend, arm_mode: backend.default_arm_mode(), ..PhysicsConfig::default() }
+    }
+}
+
 impl Default for PhysicsConfig {
     fn default() -> Self {
         PhysicsConfig {
