@@ -230,24 +230,7 @@ mod tests {
     use crate::control::task::Phase;
 
     fn row(t: f64, f: f64) -> TraceRow {
-        TraceRow {
-            time_s: t,
-            phase: Phase::Grasp,
-            true_force_n: f,
-            fbg1_nm: 0.0,
-            fbg2_nm: 0.0,
-            force_n: f,
-            force_uncompensated_n: f,
-            over_range: false,
-            setpoint_n: 0.6,
-            controller_on: true,
-            controller_output_deg_s: 0.0,
-            growth_motor_rad: 0.0,
-            twine_motor_rad: 0.0,
-            object_height_m: 0.0,
-            slip_speed_m_s: 0.0,
-            grip_force_n: 0.0,
-        }
+        TraceRow::at(t, Phase::Grasp, f)
     }
 
     fn tick(t: f64, f: f64, phase: &str) -> Tick {

@@ -41,6 +41,32 @@ pub struct TraceRow {
     pub grip_force_n: f64,
 }
 
+#[cfg(test)]
+impl TraceRow {
+    /// A tick at `time_s` in `phase` whose true force and estimates are `force_n`, everything else
+    /// zero: the rows unit tests compare traces with.
+    pub(crate) fn at(time_s: f64, phase: Phase, force_n: f64) -> TraceRow {
+        TraceRow {
+            time_s,
+            phase,
+            true_force_n: force_n,
+            fbg1_nm: 0.0,
+            fbg2_nm: 0.0,
+            force_n,
+            force_uncompensated_n: force_n,
+            over_range: false,
+            setpoint_n: 0.6,
+            controller_on: true,
+            controller_output_deg_s: 0.0,
+            growth_motor_rad: 0.0,
+            twine_motor_rad: 0.0,
+            object_height_m: 0.0,
+            slip_speed_m_s: 0.0,
+            grip_force_n: 0.0,
+        }
+    }
+}
+
 const HEADER: &str = "time_s,phase,true_force_n,fbg1_nm,fbg2_nm,force_n,force_uncompensated_n,over_range,setpoint_n,\
 controller_on,controller_output_deg_s,growth_motor_rad,twine_motor_rad,object_height_m,slip_speed_m_s,grip_force_n";
 
