@@ -207,24 +207,7 @@ mod tests {
     }
 
     fn row(t: f64, phase: Phase, force: f64) -> TraceRow {
-        TraceRow {
-            time_s: t,
-            phase,
-            true_force_n: force + 0.01,
-            fbg1_nm: 0.0,
-            fbg2_nm: 0.0,
-            force_n: force,
-            force_uncompensated_n: force,
-            over_range: false,
-            setpoint_n: 1.0,
-            controller_on: true,
-            controller_output_deg_s: 0.0,
-            growth_motor_rad: 0.0,
-            twine_motor_rad: 0.0,
-            object_height_m: 0.0,
-            slip_speed_m_s: 0.0,
-            grip_force_n: 0.0,
-        }
+        TraceRow { true_force_n: force + 0.01, setpoint_n: 1.0, ..TraceRow::at(t, phase, force) }
     }
 
     #[test]
