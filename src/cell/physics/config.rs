@@ -377,7 +377,7 @@ pub struct FingerConfig {
     /// rigid pieces at any number, `strip::layout`). 8, with `base_refinement` 8: 17.5 mm links
     /// from the pad to the tip and 2.2 mm links from the strip's base to the pad, 30 bodies in all.
     /// Its answers agree with 16 and 32 links and with a quarter of the step by the convergence
-    /// criteria in 85 of 90 comparisons, and with the uniform 64-link finger's drop times within
+    /// criteria in 89 of 90 comparisons, and with the uniform 64-link finger's drop times within
     /// 0.2 s, at 2.5 times its speed (README, "Convergence"; `docs/convergence/`). An object much
     /// smaller than the paper's (a wrap of under ~4 links per turn) should be checked at links x2
     /// (`tendril chart convergence --quick`). A numerical choice, not a calibration knob.
