@@ -37,6 +37,11 @@ pub struct CellState {
     pub twine_motor_rad: f64,
     /// The latest interrogator sample.
     pub wavelengths: Wavelengths,
+    /// The vertical load the tool carries \[N\], positive downward: what the arm's wrist force
+    /// sensor reads of the held object (and anything else pressing on the tool), its own payload
+    /// compensated. A UR5e reports it as minus the z component of RTDE `actual_TCP_force` (the
+    /// external force on the tool, base frame). `None` when the cell does not measure it.
+    pub tool_load_n: Option<f64>,
 }
 
 /// What the control code asks of the cell at each tick. Position targets, radians.

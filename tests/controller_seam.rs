@@ -77,6 +77,7 @@ impl Cell for ToyCell {
             growth_motor_rad: self.growth_rad,
             twine_motor_rad: self.twine_rad,
             wavelengths: self.bad.get(&tick).copied().unwrap_or(good),
+            tool_load_n: None,
         })
     }
     fn write(&mut self, command: &CellCommand) -> Result<(), CellError> {

@@ -47,7 +47,7 @@ const ODD: [&str; 14] =
     ["0", "-1", "0.0", "-0.0", "1e-300", "\"\"", "\"x\"", "true", "[]", "[1.0, 2.0]", "{}", "1e9", "-1e9", "4.69"];
 
 /// Keys of the pick-and-place scenario beyond those the shipped files set.
-const KEYS: [&str; 36] = [
+const KEYS: [&str; 39] = [
     "seed",
     "setpoint_n",
     "control_rate_hz",
@@ -74,6 +74,9 @@ const KEYS: [&str; 36] = [
     "slip.slip_fraction",
     "slip.lost_force_n",
     "slip.lost_hold_s",
+    "slip.load_fall_fraction",
+    "wrist.noise_n",
+    "wrist.sample_rate_hz",
     "estimator.range_n",
     "estimator.b_pm_per_n",
     "interrogator.sample_rate_hz",

@@ -62,6 +62,15 @@ fn real_path_against_virtual_devices_matches_the_twin() {
     // Not compared: the sensor-based slip detector's events, which near its thresholds are decided
     // by noise; the ground truth above is the outcome.
     phases::assert_phases_agree(&phases::from_report(&sim), &phases::from_report(&real));
+    // The wrist's load reaches the real path over RTDE (`actual_TCP_force`): once lifted, the mean
+    // of the lift's last second is the crimper's weight, within 0.25 N (the noise of a tick's
+    // reading, 0.78 N, over 100 ticks: 0.08 N).
+    let weight = summary.run.mass_kg * 9.81;
+    let end = real.rows.iter().rev().find(|r| r.phase == Phase::Lift).unwrap().time_s;
+    let last_second: Vec<f64> =
+        real.rows.iter().filter(|r| r.phase == Phase::Lift && r.time_s > end - 1.0).map(|r| r.tool_load_n).collect();
+    let mean = last_second.iter().sum::<f64>() / last_second.len() as f64;
+    assert!((mean - weight).abs() < 0.25, "tool load {mean:.3} N in the lift's last second, m g = {weight:.3} N");
 }
 
 /// Whether the object was ever touched in `samples` (twin time \[s\], contact), and the longest

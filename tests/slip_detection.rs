@@ -1,17 +1,24 @@
 //! The slip detector against the twin's ground truth (`control::slip`): it sees the drops the pad
-//! feels, stays quiet on a steady grip under a noisy interrogator, and (a finding, kept true by
-//! this test) cannot see a drop that happens after the pad has already lost the object.
+//! feels, stays quiet on a steady grip under a noisy interrogator, and, with the wrist's load
+//! (`control::load`), sees the falls the pad cannot: an object that drops after the pad has already
+//! lost it. Without the wrist sensor that stays a finding, kept true here too.
 
 use std::path::Path;
 use tendril::run::execute::run_on_twin;
+use tendril::run::runner::RunReport;
 use tendril::run::summary::RunSummary;
 
 /// `scenarios/NAME.toml` with `overrides`, run on the twin (nothing written).
 fn run(name: &str, overrides: &[&str]) -> RunSummary {
+    run_report(name, overrides).0
+}
+
+/// As [`run`], with the run's report (its rows).
+fn run_report(name: &str, overrides: &[&str]) -> (RunSummary, RunReport) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
     let overrides: Vec<tendril::scenario::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
     let scenario = tendril::scenario::load(&path, &overrides).unwrap();
-    run_on_twin(&scenario, &Default::default(), None).unwrap().0
+    run_on_twin(&scenario, &Default::default(), None).unwrap()
 }
 
 /// The knock: the arm at the paper's limits and 0.3 N·s along world +x, 1 s into the
@@ -47,14 +54,50 @@ fn a_steady_grip_under_thirty_picometres_of_noise_raises_no_alarm() {
 }
 
 #[test]
-fn without_feedback_the_pad_loses_the_crimper_seconds_before_it_falls() {
+fn without_feedback_and_without_a_wrist_sensor_the_pad_loses_the_crimper_seconds_before_it_falls() {
     // The object then hangs on the palm's pinch (models/README.md): the sensor's loss is a false
     // alarm by the ground truth, and the drop itself is not seen. On the converged default the pad
     // lets go 2.2 s before the crimper falls (seed 1: alarm 7.83 s, drop 9.98 s; 4-8 s on the
     // coarser 32-link finger).
-    let s = run("crimper", &["feedback=false"]);
+    let s = run("crimper", &["feedback=false", "wrist.present=false"]);
     assert_eq!(s.outcome, "dropped");
     let (drop, alarm) = (s.drop_time_s.unwrap(), s.drop_alarm_s.expect("the pad's loss is an alarm"));
     assert!(drop - alarm > 1.0, "alarm at {alarm} s, drop at {drop} s");
     assert_eq!((s.false_alarms, s.drop_detection_delay_s), (Some(1), None));
+}
+
+#[test]
+fn without_feedback_the_wrist_sees_the_fall_the_pad_cannot() {
+    // The same runs with the wrist's load: the pad's loss, seconds before the fall, only warns,
+    // and the fall itself raises the drop alarm.
+    for object in ["crimper", "shampoo"] {
+        let s = run(object, &["feedback=false"]);
+        assert_eq!(s.outcome, "dropped", "{object}");
+        let drop = s.drop_time_s.unwrap();
+        let delay = s.drop_detection_delay_s.unwrap_or_else(|| panic!("{object}: drop not seen: {s:?}"));
+        assert!(delay <= 0.3, "{object}: seen {delay} s after the drop");
+        assert_eq!(s.false_alarms, Some(0), "{object}");
+        let warned = s.slip_detected_s.unwrap_or_else(|| panic!("{object}: the pad's loss warns"));
+        assert!(drop - warned > 1.0, "{object}: warned at {warned} s, drop at {drop} s");
+    }
+}
+
+#[test]
+fn the_wrist_reads_the_carried_objects_weight() {
+    // Noise off: the physics' load itself. Every tick with the object off the table, through the
+    // arm's accelerations and the finger's creep, reads the object's weight within 1 %.
+    for object in ["crimper", "hammer"] {
+        let (s, report) = run_report(object, &["wrist.noise_n=0"]);
+        let weight = s.run.mass_kg * 9.81;
+        let carried: Vec<f64> = report
+            .rows
+            .iter()
+            .filter(|r| r.phase.arm_moving() && r.object_height_m > 0.005)
+            .map(|r| r.tool_load_n)
+            .collect();
+        assert!(carried.len() > 1500, "{object}: {} ticks carried", carried.len());
+        for load in &carried {
+            assert!((load / weight - 1.0).abs() < 0.01, "{object}: {load} N against m g = {weight} N");
+        }
+    }
 }

@@ -7,6 +7,7 @@
 use super::disturbance::{DisturbanceConfig, DisturbanceSchedule};
 use super::fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
 use super::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel};
+use super::wrist::{WristConfig, WristSensor};
 use crate::control::gripper::GripperConfig;
 use crate::control::task::Phase;
 use crate::hardware::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
@@ -54,6 +55,8 @@ pub struct SimCell {
     sensor_config: SensorConfig,
     interrogator: InterrogatorConfig,
     sensor: FbgSensor,
+    wrist_config: WristConfig,
+    wrist: WristSensor,
     gripper: GripperConfig,
     environment: EnvironmentConfig,
     seed: u64,
@@ -143,6 +146,8 @@ impl SimCell {
     ) -> SimCell {
         SimCell {
             sensor: FbgSensor::new(&sensor, &interrogator, seed),
+            wrist_config: WristConfig::default(),
+            wrist: WristSensor::new(&WristConfig::default(), seed),
             model,
             scene: None,
             sensor_config: sensor,
@@ -170,6 +175,14 @@ impl SimCell {
         self
     }
 
+    /// Reads the tool's load through a wrist force sensor like `wrist` (`[wrist]`; the default
+    /// otherwise).
+    pub fn with_wrist(mut self, wrist: WristConfig) -> SimCell {
+        self.wrist_config = wrist;
+        self.wrist = WristSensor::new(&wrist, self.seed);
+        self
+    }
+
     /// Records the scene's MuJoCo state at `fps` frames per second of cell time from activation on
     /// (for `tendril render`); [`SimCell::take_frames`] hands them over.
     /// Reading the state changes nothing in the run.
@@ -194,6 +207,7 @@ impl SimCell {
             scenario.seed,
         )
         .with_disturbances(scenario.disturbance.clone())
+        .with_wrist(scenario.wrist)
     }
 
     fn scene(&self) -> &dyn Physics {
@@ -249,6 +263,7 @@ impl Cell for SimCell {
         require_state(self.lifecycle, Lifecycle::Unconfigured, "configure")?;
         self.scene = Some(self.model.start().map_err(Self::physics_error)?);
         self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
+        self.wrist = WristSensor::new(&self.wrist_config, self.seed);
         self.next_sample_s = 0.0;
         self.disturbances.restart();
         self.pushing = false;
@@ -283,6 +298,10 @@ impl Cell for SimCell {
             growth_motor_rad: self.gripper.growth_motor_rad(r.growth_m),
             twine_motor_rad: r.twine_m / self.gripper.twine_spool_radius_m,
             wavelengths: self.latest,
+            tool_load_n: r
+                .tool_load_n
+                .filter(|_| self.wrist_config.present)
+                .map(|load| self.wrist.read(load, r.time_s)),
         })
     }
 

@@ -35,33 +35,62 @@ pub const MAX_WINDOW_TICKS: usize = 25;
 #[derive(Debug, Clone)]
 pub struct ContactDetector {
     rise_n: f64,
-    /// Welford's running count, mean and sum of squared deviations of the unloaded readings.
-    count: u64,
-    mean_n: f64,
-    m2: f64,
+    /// The unloaded readings' statistics.
+    unloaded: RunningStats,
     window: VecDeque<f64>,
+}
+
+/// Welford's running count, mean and sum of squared deviations: the noise of readings learnt one
+/// at a time (non-finite ones left out).
+#[derive(Debug, Clone, Default)]
+pub struct RunningStats {
+    count: u64,
+    mean: f64,
+    m2: f64,
+}
+
+impl RunningStats {
+    /// Adds one reading; a non-finite one is left out (it would poison the rest).
+    pub fn add(&mut self, x: f64) {
+        if !x.is_finite() {
+            return;
+        }
+        self.count += 1;
+        let delta = x - self.mean;
+        self.mean += delta / self.count as f64;
+        self.m2 += delta * (x - self.mean);
+    }
+
+    /// How many readings were added.
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+
+    /// Their mean (0 before the first).
+    pub fn mean(&self) -> f64 {
+        self.mean
+    }
+
+    /// Their sample standard deviation (0 before two of them).
+    pub fn sd(&self) -> f64 {
+        if self.count < 2 { 0.0 } else { (self.m2 / (self.count - 1) as f64).sqrt() }
+    }
 }
 
 impl ContactDetector {
     /// A detector for a rise of `rise_n` \[N\] above the unloaded reading, nothing learnt yet.
     pub fn new(rise_n: f64) -> Self {
-        ContactDetector { rise_n, count: 0, mean_n: 0.0, m2: 0.0, window: VecDeque::new() }
+        ContactDetector { rise_n, unloaded: RunningStats::default(), window: VecDeque::new() }
     }
 
     /// Learns from one estimate taken with nothing on the sensor \[N\].
     pub fn observe_unloaded(&mut self, force_n: f64) {
-        if !force_n.is_finite() {
-            return;
-        }
-        self.count += 1;
-        let delta = force_n - self.mean_n;
-        self.mean_n += delta / self.count as f64;
-        self.m2 += delta * (force_n - self.mean_n);
+        self.unloaded.add(force_n);
     }
 
     /// Standard deviation of the unloaded readings \[N\] (0 before two of them).
     pub fn noise_n(&self) -> f64 {
-        if self.count < 2 { 0.0 } else { (self.m2 / (self.count - 1) as f64).sqrt() }
+        self.unloaded.sd()
     }
 
     /// How many readings the decision averages.

@@ -19,6 +19,7 @@ pub mod estimate;
 pub mod feedforward;
 pub mod gripper;
 pub mod hysteresis;
+pub mod load;
 pub mod pid;
 pub mod slip;
 pub mod slip_margin;

@@ -8,15 +8,25 @@
 //!   object leaving the hand unloads the pad within a tenth of a second), or when contact is lost
 //!   (within `lost_force_n` of the unloaded reading for `lost_hold_s`).
 //!
+//! With a wrist force sensor ([`crate::hardware::CellState::tool_load_n`]) a third cue watches the
+//! load the tool carries ([`super::load`]): a drop alarm when it falls by half. Once it can see the
+//! object's weight go, the pad's *loss* only warns of slip (the pad may lose an object that still
+//! hangs in the hand, and it cannot see one leave a grip whose pad keeps its load), while the pad's
+//! sudden *fall* still raises the alarm (a knock that sets the object sliding down the grip unloads
+//! the pad at once, and the wrist only as the slide speeds up).
+//!
 //! Each alarm starts an episode; an episode ends once its cue has been clear for [`REARM_S`]. On
 //! the twin the episodes are judged against the ground truth ([`judge`]): the delay from the true
 //! drop to the first drop alarm, and the drop alarms that no drop followed (false alarms).
 //!
 //! What the pad cannot see: a drop while the pad is already unloaded (without feedback the shampoo
 //! hangs on the palm's pinch for seconds after the pad lost it), and an object sliding through a
-//! grip whose pad keeps its load (near-zero friction). README, "Disturbances", has the figures.
+//! grip whose pad keeps its load (near-zero friction). What neither sees: an object that slides
+//! down the grip and stays in the hand (the knocked hammer). README, "Disturbances", has the
+//! figures.
 
 use super::contact::{MAX_WINDOW_TICKS, Z};
+use super::load::LoadCue;
 use crate::scenario::{Checker, Validate};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -55,11 +65,23 @@ pub struct SlipConfig {
     /// The window of the fall \[s\]. 0.2 s: a drop unloads the pad in 0.1-0.2 s on the twin, while
     /// the grip's creep without feedback takes seconds to lose as much.
     pub fall_window_s: f64,
+    /// With a wrist force sensor, a drop alarm is raised when the tool's load falls by this
+    /// fraction of the load carried ([`super::load`]). 0.5: an object leaving the hand takes all
+    /// of its weight; the carried load moves by a few percent with the arm's accelerations (the
+    /// paper's 15 °/s² over the arm's reach of about 0.6 m: 0.16 m/s², under 2 % of g).
+    pub load_fall_fraction: f64,
 }
 
 impl Default for SlipConfig {
     fn default() -> Self {
-        SlipConfig { slip_fraction: 0.5, lost_force_n: 0.05, lost_hold_s: 0.2, fall_fraction: 0.5, fall_window_s: 0.2 }
+        SlipConfig {
+            slip_fraction: 0.5,
+            lost_force_n: 0.05,
+            lost_hold_s: 0.2,
+            fall_fraction: 0.5,
+            fall_window_s: 0.2,
+            load_fall_fraction: 0.5,
+        }
     }
 }
 
@@ -82,6 +104,11 @@ impl Validate for SlipConfig {
         at.require("fall_window_s", self.fall_window_s > 0.0 && self.fall_window_s <= 10.0, || {
             format!("must be > 0 and at most 10 s, got {}", self.fall_window_s)
         });
+        // A fall of the whole load or more can never be read (the load cannot fall below zero),
+        // and 0 would alarm on every tick.
+        at.require("load_fall_fraction", self.load_fall_fraction > 0.0 && self.load_fall_fraction < 1.0, || {
+            format!("must be > 0 and < 1, got {}", self.load_fall_fraction)
+        });
     }
 }
 
@@ -94,6 +121,9 @@ pub struct SlipEvents {
     pub lost_s: Option<f64>,
     /// When the first drop alarm (a fall, or the loss) was raised \[s\].
     pub drop_alarm_s: Option<f64>,
+    /// When the detector judged the object gone \[s\]: the wrist's fall once its cue is armed,
+    /// else the pad's loss (`lost_s`). What a cell without ground truth reports as the drop.
+    pub dropped_s: Option<f64>,
 }
 
 /// The alarm episodes of a run.
@@ -136,6 +166,8 @@ pub struct SlipDetector {
     averaged: VecDeque<(f64, f64)>,
     warning: Episodes,
     drop: Episodes,
+    /// The wrist's cue (never armed on a cell without a wrist sensor).
+    load: LoadCue,
 }
 
 impl SlipDetector {
@@ -150,7 +182,20 @@ impl SlipDetector {
             averaged: VecDeque::new(),
             warning: Episodes::default(),
             drop: Episodes::default(),
+            load: LoadCue::new(config.load_fall_fraction),
         }
+    }
+
+    /// Learns the wrist's zero and noise from one reading at home (`None`: no wrist sensor).
+    pub fn observe_home_load(&mut self, load_n: Option<f64>) {
+        if let Some(load) = load_n {
+            self.load.observe_home(load);
+        }
+    }
+
+    /// The wrist's cue.
+    pub fn load_cue(&self) -> &LoadCue {
+        &self.load
     }
 
     /// How many estimates the cues average for a reading noise of `noise_n` \[N\] (1 SD) and a
@@ -165,24 +210,59 @@ impl SlipDetector {
         (k as usize).clamp(1, MAX_WINDOW_TICKS)
     }
 
-    /// Feeds one estimate. `unloaded_n` is what the estimator reads with nothing on the sensor
+    /// Feeds one tick: the force estimate and the wrist's reading of the tool's load (`None`
+    /// without a wrist sensor). `unloaded_n` is what the estimator reads with nothing on the sensor
     /// (the estimate at the tare) and `noise_n` the SD of the readings there; `holding` is true in
     /// the phases where the object must stay in the hand; `reference_n` is the force the grasp
     /// should have (the setpoint).
+    #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         time_s: f64,
         force_n: f64,
+        load_n: Option<f64>,
         unloaded_n: f64,
         noise_n: f64,
         reference_n: f64,
         holding: bool,
     ) -> SlipEvents {
-        if !holding || self.events.lost_s.is_some() {
+        let load_fell = self.load.update(load_n, holding);
+        if !holding {
             self.below_since = None;
             self.recent.clear();
             self.averaged.clear();
             return self.events;
+        }
+        let pad = self.pad_cues(time_s, force_n, unloaded_n, noise_n, reference_n);
+        // With the wrist armed, the pad's loss only warns: the hand still carries the object (it
+        // hangs on the pinch). The pad's sudden fall stays an alarm: something moved the object in
+        // the hand, and a slide the wrist sees only once it speeds up may follow.
+        let wrist = self.load.armed();
+        let drop_on = if wrist { load_fell || pad.fell } else { pad.fell || pad.lost };
+        if self.warning.update(time_s, pad.below_slip || (wrist && pad.lost)) {
+            self.alarms.warnings_s.push(time_s);
+        }
+        if self.drop.update(time_s, drop_on) {
+            let pad_loss = (!wrist && pad.lost).then_some(self.events.lost_s).flatten();
+            self.alarms.drops_s.push(pad_loss.unwrap_or(time_s));
+        }
+        if drop_on && self.events.drop_alarm_s.is_none() {
+            self.events.drop_alarm_s = self.alarms.drops_s.last().copied();
+        }
+        if self.events.dropped_s.is_none() {
+            self.events.dropped_s = match (wrist, load_fell, pad.lost) {
+                (true, true, _) => Some(time_s),
+                (false, _, true) => self.events.lost_s,
+                _ => None,
+            };
+        }
+        self.events
+    }
+
+    /// The pad's cues this tick (all off once the pad has lost the object).
+    fn pad_cues(&mut self, time_s: f64, force_n: f64, unloaded_n: f64, noise_n: f64, reference_n: f64) -> PadCues {
+        if self.events.lost_s.is_some() {
+            return PadCues::default();
         }
         let k = self.window_ticks(noise_n, reference_n);
         self.recent.push_back(force_n);
@@ -199,10 +279,6 @@ impl SlipDetector {
         if below_slip && self.events.slip_start_s.is_none() {
             self.events.slip_start_s = Some(time_s);
         }
-        if self.warning.update(time_s, below_slip) {
-            self.alarms.warnings_s.push(time_s);
-        }
-
         let highest = self.averaged.iter().map(|&(_, m)| m).fold(f64::NEG_INFINITY, f64::max);
         let fell = highest - mean >= self.config.fall_fraction * reference_n;
         let lost_n = self.config.lost_force_n.max(Z * noise_n / (k as f64).sqrt());
@@ -217,13 +293,7 @@ impl SlipDetector {
         } else {
             self.below_since = None;
         }
-        if self.drop.update(time_s, fell || lost) {
-            self.alarms.drops_s.push(if lost { self.events.lost_s.unwrap_or(time_s) } else { time_s });
-        }
-        if (fell || lost) && self.events.drop_alarm_s.is_none() {
-            self.events.drop_alarm_s = self.alarms.drops_s.last().copied();
-        }
-        self.events
+        PadCues { below_slip, fell, lost }
     }
 
     /// The events so far.
@@ -235,6 +305,17 @@ impl SlipDetector {
     pub fn alarms(&self) -> &Alarms {
         &self.alarms
     }
+}
+
+/// The pad's cues on one tick.
+#[derive(Debug, Clone, Copy, Default)]
+struct PadCues {
+    /// The averaged estimate is below the slip warning's threshold.
+    below_slip: bool,
+    /// It fell by the drop alarm's fraction within the fall window.
+    fell: bool,
+    /// Contact is lost (this tick the loss was declared).
+    lost: bool,
 }
 
 /// The drop alarms judged against the true drop (on the twin, which knows it).
@@ -270,7 +351,7 @@ mod tests {
         for i in 0..1000 {
             let t = i as f64 * 0.01;
             let f = if t < 2.0 { 1.6 } else { (1.6 * (1.0 - (t - 2.0) / 4.0)).max(0.0) };
-            d.update(t, f, 0.0, 0.0, 1.6, true);
+            d.update(t, f, None, 0.0, 0.0, 1.6, true);
         }
         let e = d.events();
         assert!((e.slip_start_s.unwrap() - 4.0).abs() < 0.02, "{e:?}");
@@ -283,11 +364,11 @@ mod tests {
         for i in 0..100 {
             let t = i as f64 * 0.01;
             let f = if i % 10 == 0 { 0.0 } else { 1.0 };
-            d.update(t, f + 0.16, 0.16, 0.0, 1.0, true);
+            d.update(t, f + 0.16, None, 0.16, 0.0, 1.0, true);
         }
         assert_eq!(d.events().lost_s, None);
-        d.update(1.0, 0.0, 0.0, 0.0, 1.0, false);
-        d.update(2.0, 0.0, 0.0, 0.0, 1.0, false);
+        d.update(1.0, 0.0, None, 0.0, 0.0, 1.0, false);
+        d.update(2.0, 0.0, None, 0.0, 0.0, 1.0, false);
         assert_eq!(d.events().lost_s, None);
     }
 
@@ -296,7 +377,7 @@ mod tests {
         let n = (seconds * 100.0) as usize;
         for (i, e) in crate::control::contact::gaussian(sigma, n, 11).into_iter().enumerate() {
             let t = i as f64 * 0.01;
-            d.update(t, f(t) + e, 0.16, sigma, 0.6, true);
+            d.update(t, f(t) + e, None, 0.16, sigma, 0.6, true);
         }
     }
 
@@ -320,6 +401,57 @@ mod tests {
         assert_eq!(d.alarms().warnings_s.len(), 1, "{:?}", d.alarms());
         let first = d.alarms().drops_s[0];
         assert!((15.0..15.3).contains(&first), "{:?}", d.alarms());
+    }
+
+    /// A detector that learnt the wrist's noise (0.78 N, the default per tick) at home, fed 10 s
+    /// of `pad(t)` and a wrist reading of `load(t)` with that noise, all while holding.
+    fn with_wrist(pad: impl Fn(f64) -> f64, load: impl Fn(f64) -> f64) -> SlipDetector {
+        let mut d = SlipDetector::new(SlipConfig::default());
+        for e in crate::control::contact::gaussian(0.78, 50, 5) {
+            d.observe_home_load(Some(e));
+        }
+        for (i, e) in crate::control::contact::gaussian(0.78, 1000, 9).into_iter().enumerate() {
+            let t = i as f64 * 0.01;
+            d.update(t, pad(t), Some(load(t) + e), 0.16, 0.0, 0.6, true);
+        }
+        d
+    }
+
+    #[test]
+    fn with_the_wrist_armed_the_pads_loss_only_warns_and_the_loads_fall_raises_the_drop_alarm() {
+        // The pad's load creeps away between 1 and 3 s (the object hangs on the pinch); the hand
+        // carries 3.4 N until 6 s.
+        let d = with_wrist(|t| 0.76 - 0.3 * (t - 1.0).clamp(0.0, 2.0), |t| if t < 6.0 { 3.4 } else { 0.0 });
+        let (events, alarms) = (d.events(), d.alarms());
+        assert!(events.lost_s.is_some_and(|t| (2.7..3.0).contains(&t)), "{events:?}");
+        assert!(alarms.warnings_s.first().is_some_and(|t| (2.4..2.6).contains(t)), "{alarms:?}");
+        assert_eq!(alarms.drops_s.len(), 1, "{alarms:?}");
+        assert!((6.0..6.1).contains(&alarms.drops_s[0]), "{alarms:?}");
+        assert_eq!(events.dropped_s, Some(alarms.drops_s[0]));
+        assert_eq!(events.drop_alarm_s, Some(alarms.drops_s[0]));
+    }
+
+    #[test]
+    fn with_the_wrist_armed_a_sudden_fall_of_the_pad_still_raises_the_drop_alarm() {
+        // A knock unloads the pad at once at 3 s; the object slides down the grip while the hand
+        // still carries it.
+        let d = with_wrist(|t| if t < 3.0 { 0.76 } else { 0.16 }, |_| 3.4);
+        assert_eq!(d.alarms().drops_s, vec![3.0], "{:?}", d.alarms());
+        assert_eq!(d.events().dropped_s, None, "the hand still carries the object");
+    }
+
+    #[test]
+    fn without_a_wrist_reading_the_pads_loss_is_the_drop() {
+        let mut d = SlipDetector::new(SlipConfig::default());
+        d.observe_home_load(None);
+        for i in 0..600 {
+            let t = i as f64 * 0.01;
+            d.update(t, if t < 3.0 { 0.76 } else { 0.16 }, None, 0.16, 0.0, 0.6, true);
+        }
+        let events = d.events();
+        assert!(events.lost_s.is_some_and(|t| (3.0..3.05).contains(&t)), "{events:?}");
+        assert_eq!(events.dropped_s, events.lost_s);
+        assert_eq!(d.alarms().drops_s.first().copied(), events.lost_s);
     }
 
     #[test]

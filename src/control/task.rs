@@ -490,6 +490,7 @@ mod tests {
                 growth_motor_rad: 0.0,
                 twine_motor_rad: twine_deg.to_radians(),
                 wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+                tool_load_n: None,
             };
             let d = seq.update(&state, force, dt);
             if phases.last() != Some(&d.phase) {
@@ -576,6 +577,7 @@ mod tests {
             growth_motor_rad: 0.0,
             twine_motor_rad: 0.0,
             wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+            tool_load_n: None,
         };
         seq.update(&state, 0.5, 0.01);
         let (phase, outlook) = seen.lock().unwrap()[0];

@@ -167,6 +167,9 @@ pub fn run_task_observed(
                 unloaded_n = estimator.estimate(mean).map_or(0.0, |e| e.force_n);
                 sequencer.set_unloaded_reading(unloaded_n);
             }
+            if sequencer.phase() == Phase::Home {
+                slip.observe_home_load(state.tool_load_n);
+            }
             let estimate = match held {
                 Some(e) => {
                     dropped_samples += 1;
@@ -186,6 +189,7 @@ pub fn run_task_observed(
             slip.update(
                 state.time_s,
                 estimate.force_n,
+                state.tool_load_n,
                 unloaded_n,
                 sequencer.reading_noise_n(),
                 plan.setpoint_n,
@@ -215,6 +219,7 @@ pub fn run_task_observed(
                 object_height_m: truth.map_or(nan, |t| t.object_height_m),
                 slip_speed_m_s: truth.map_or(nan, |t| t.slip_speed_m_s),
                 grip_force_n: truth.map_or(nan, |t| t.grip_force_n),
+                tool_load_n: state.tool_load_n.unwrap_or(nan),
             };
             if let Some(w) = trace.as_deref_mut() {
                 w.write(&row).map_err(|e| CellError::Device { device: "trace".into(), cause: e.to_string() })?;
@@ -236,7 +241,7 @@ pub fn run_task_observed(
     }
     let error = result.err().or(stop.err()).map(|e| e.to_string());
 
-    let sensor_drop = slip.events().lost_s.map(|t| Drop { cell_time_s: t, phase: phase_at(&rows, t) });
+    let sensor_drop = slip.events().dropped_s.map(|t| Drop { cell_time_s: t, phase: phase_at(&rows, t) });
     let has_truth = rows.first().is_some_and(|r| r.true_force_n.is_finite());
     let drop = if has_truth { truth_drop } else { sensor_drop };
     let outcome = match (&error, drop) {

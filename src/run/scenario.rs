@@ -15,6 +15,7 @@ use crate::cell::fbg::{InterrogatorConfig, SensorConfig};
 use crate::cell::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneSpec};
 use crate::cell::real::HardwareConfig;
 use crate::cell::sim::EnvironmentConfig;
+use crate::cell::wrist::WristConfig;
 use crate::control::controller::ControllerConfig;
 use crate::control::estimate::ForceCalibration;
 use crate::control::gripper::GripperConfig;
@@ -72,6 +73,9 @@ pub struct PickPlaceScenario {
     /// Temperature at the sensor.
     #[serde(default)]
     pub environment: EnvironmentConfig,
+    /// The arm's wrist force sensor on the twin (the load the tool carries).
+    #[serde(default)]
+    pub wrist: WristConfig,
     /// MuJoCo settings.
     #[serde(default)]
     pub physics: PhysicsConfig,
@@ -112,6 +116,7 @@ impl Validate for PickPlaceScenario {
         at.section("sensor", &self.sensor);
         at.section("interrogator", &self.interrogator);
         at.section("environment", &self.environment);
+        at.section("wrist", &self.wrist);
         at.section("physics", &self.physics);
         at.section("finger", &self.finger);
         at.section("hardware", &self.hardware);

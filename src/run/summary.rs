@@ -57,7 +57,8 @@ pub struct RunSummary {
     pub drop_phase: Option<String>,
     /// When the sensor-based detector saw slip start, after the arm started moving \[s\].
     pub slip_detected_s: Option<f64>,
-    /// When the sensor-based detector raised its first drop alarm (a sudden fall, or the loss),
+    /// When the sensor-based detector raised its first drop alarm (the pad's sudden fall or loss;
+    /// with a wrist force sensor, once it reads the object's weight, the tool's load falling),
     /// after the arm started moving \[s\].
     #[serde(default)]
     pub drop_alarm_s: Option<f64>,

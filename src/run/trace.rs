@@ -39,6 +39,8 @@ pub struct TraceRow {
     pub slip_speed_m_s: f64,
     /// Total grip normal force \[N\] (NaN without ground truth).
     pub grip_force_n: f64,
+    /// The tool's load as the wrist force sensor reads it \[N\] (NaN without one).
+    pub tool_load_n: f64,
 }
 
 #[cfg(test)]
@@ -63,12 +65,14 @@ impl TraceRow {
             object_height_m: 0.0,
             slip_speed_m_s: 0.0,
             grip_force_n: 0.0,
+            tool_load_n: 0.0,
         }
     }
 }
 
 const HEADER: &str = "time_s,phase,true_force_n,fbg1_nm,fbg2_nm,force_n,force_uncompensated_n,over_range,setpoint_n,\
-controller_on,controller_output_deg_s,growth_motor_rad,twine_motor_rad,object_height_m,slip_speed_m_s,grip_force_n";
+controller_on,controller_output_deg_s,growth_motor_rad,twine_motor_rad,object_height_m,slip_speed_m_s,grip_force_n,\
+tool_load_n";
 
 /// Bytes of whole rows collected before they are written: 8 KiB (about 70 rows, 0.7 s of a run
 /// at 100 Hz), what a `BufWriter` holds, so a process killed outright loses as little as before.
@@ -126,7 +130,7 @@ impl TraceWriter {
         // Formatted straight into the row buffer: no allocation per control tick.
         writeln!(
             self.buffer,
-            "{:.4},{},{:.5},{:.4},{:.4},{:.5},{:.5},{},{:.3},{},{:.3},{:.5},{:.5},{:.5},{:.5},{:.4}",
+            "{:.4},{},{:.5},{:.4},{:.4},{:.5},{:.5},{},{:.3},{},{:.3},{:.5},{:.5},{:.5},{:.5},{:.4},{:.3}",
             r.time_s,
             r.phase.name(),
             r.true_force_n,
@@ -143,6 +147,7 @@ impl TraceWriter {
             r.object_height_m,
             r.slip_speed_m_s,
             r.grip_force_n,
+            r.tool_load_n,
         )?;
         if self.buffer.len() >= BUFFER_BYTES { self.flush_rows() } else { Ok(()) }
     }

@@ -450,6 +450,7 @@ mod tests {
             object_height_m: 0.1,
             slip_speed_m_s: 0.0,
             grip_force_n: 2.0,
+            tool_load_n: 3.4,
         }
     }
 

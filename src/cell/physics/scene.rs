@@ -37,6 +37,9 @@ pub(crate) struct Ids {
     pub(crate) finger_geoms: Vec<usize>,
     /// The palm beside the guide exit.
     pub(crate) palm_geom: Vec<usize>,
+    /// Every geom the arm carries (its links, the hand, palm, strip and pad): what the object can
+    /// load the wrist through.
+    pub(crate) hand_geoms: Vec<usize>,
     /// The object's geoms (empty without object).
     pub(crate) object_geoms: Vec<usize>,
     pub(crate) object_body: Option<usize>,
@@ -138,6 +141,10 @@ impl SceneModel {
         } else {
             (Vec::new(), None, None, None)
         };
+        let hand_body = id(m, mjOBJ_BODY, "body", "hand")?;
+        let arm_root = m.body_rootid()[hand_body];
+        let hand_geoms =
+            (0..m.ffi().ngeom as usize).filter(|&g| m.body_rootid()[m.geom_bodyid()[g] as usize] == arm_root).collect();
         let names = ["shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"];
         let mut arm_qpos = [0; 6];
         let mut arm_dof = [0; 6];
@@ -171,11 +178,12 @@ impl SceneModel {
             pad_geoms,
             finger_geoms,
             palm_geom: vec![geom("palm")?],
+            hand_geoms,
             object_geoms,
             object_body,
             object_grip,
             object_qpos,
-            hand_body: id(m, mjOBJ_BODY, "body", "hand")?,
+            hand_body,
             growth_qpos: qpos("growth")?,
             twine_qpos: qpos("twine")?,
             creep_qpos: qpos("creep")?,
@@ -262,6 +270,12 @@ pub struct PhysicsReadout {
     pub tendon_tension_n: f64,
     /// Arm joint angles \[rad\] (kinematic mode: the rate-limited commanded angles).
     pub arm_q: [f64; 6],
+    /// The object's vertical load on the arm \[N\]: the upward (world +z) component of every
+    /// contact force the arm and what it carries (links, hand, palm, strip, pad) exert on the
+    /// object, so an object hanging still in the grip reads its weight. What the arm's wrist force
+    /// sensor adds to the tool's own load ([`crate::cell::wrist`]). `None` where the backend does
+    /// not resolve contact forces into vectors (rapier).
+    pub tool_load_n: Option<f64>,
 }
 
 /// One MuJoCo simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a
@@ -401,6 +415,29 @@ impl Scene {
         (sum, n)
     }
 
+    /// The upward (world +z) component of the contact forces geoms `a` exert on geoms `b` \[N\].
+    pub fn vertical_force_on(&self, a: &[usize], b: &[usize]) -> f64 {
+        let mut up = 0.0;
+        for (i, c) in self.data.contact().iter().enumerate() {
+            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+            // MuJoCo's contact frame: rows normal, tangent 1, tangent 2; the normal points from
+            // geom1 to geom2, and the force in that frame is the one geom1 exerts on geom2.
+            let sign = if a.contains(&g1) && b.contains(&g2) {
+                1.0
+            } else if a.contains(&g2) && b.contains(&g1) {
+                -1.0
+            } else {
+                continue;
+            };
+            if c.efc_address >= 0 {
+                let f = self.data.contact_force(i);
+                let z = f[0] * c.frame[2] + f[1] * c.frame[5] + f[2] * c.frame[8];
+                up += sign * z;
+            }
+        }
+        up
+    }
+
     /// The pad's normal force as MuJoCo's `touch` sensor on `pad_site` reports it \[N\].
     pub fn pad_touch_sensor_n(&self) -> f64 {
         self.data.sensordata()[self.shared.ids.pad_touch_adr]
@@ -522,6 +559,7 @@ impl Physics for Scene {
         let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
         let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
         let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
+        let tool_load_n = Some(self.vertical_force_on(&ids.hand_geoms, &ids.object_geoms));
         let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
         let hq = self.data.xquat()[ids.hand_body];
         let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
@@ -533,6 +571,7 @@ impl Physics for Scene {
             palm_force_n,
             grip_contacts,
             touching: grip_contacts > 0,
+            tool_load_n,
             hand_pos_m: hand_p.into(),
             growth_m: qpos[ids.growth_qpos],
             twine_m: qpos[ids.twine_qpos],

@@ -359,8 +359,16 @@ impl Cell for RealCell {
             ));
         }
         let [growth, twine] = motors.rad;
+        let tool_load_n = d.ur.take_tool_load();
         self.last_arm_q = Some(arm.q);
-        Ok(CellState { time_s, arm_q: arm.q, growth_motor_rad: growth, twine_motor_rad: twine, wavelengths })
+        Ok(CellState {
+            time_s,
+            arm_q: arm.q,
+            growth_motor_rad: growth,
+            twine_motor_rad: twine,
+            wavelengths,
+            tool_load_n,
+        })
     }
 
     fn write(&mut self, c: &CellCommand) -> Result<(), CellError> {

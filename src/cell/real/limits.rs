@@ -194,6 +194,7 @@ mod tests {
                 growth_motor_rad: 0.0,
                 twine_motor_rad: self.twine,
                 wavelengths: self.w,
+                tool_load_n: None,
             })
         }
         fn write(&mut self, c: &CellCommand) -> Result<(), CellError> {

@@ -14,8 +14,16 @@ use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::tcp::OwnedWriteHalf;
 
 /// Output fields requested, in recipe order (the names [`ArmSample`] is decoded from).
-pub const OUTPUT_NAMES: [&str; 7] =
-    ["timestamp", "actual_q", "actual_qd", "actual_TCP_pose", "robot_mode", "safety_mode", "runtime_state"];
+pub const OUTPUT_NAMES: [&str; 8] = [
+    "timestamp",
+    "actual_q",
+    "actual_qd",
+    "actual_TCP_pose",
+    "robot_mode",
+    "safety_mode",
+    "runtime_state",
+    "actual_TCP_force",
+];
 
 /// RTDE output rate \[Hz\]: the e-Series maximum.
 pub const OUTPUT_RATE_HZ: f64 = 500.0;
@@ -44,6 +52,16 @@ pub struct ArmSample {
     pub safety_mode: i32,
     /// Runtime state (2 playing).
     pub runtime_state: u32,
+    /// The external wrench on the tool, base frame (N, N·m), the payload compensated.
+    pub tcp_force: [f64; 6],
+}
+
+impl ArmSample {
+    /// The vertical load the tool carries \[N\], positive downward: minus the z component of
+    /// the external force on the tool ([`crate::hardware::CellState::tool_load_n`]).
+    pub fn tool_load_n(&self) -> f64 {
+        -self.tcp_force[2]
+    }
 }
 
 /// The reader task's view: the latest sample, when it arrived, and the error that ended the stream.
@@ -53,6 +71,35 @@ pub struct ArmFeed {
     pub latest: Option<(ArmSample, Instant)>,
     /// Why the stream ended, if it did.
     pub closed: Option<String>,
+    /// The tool's load over the samples since it was last taken ([`UrClient::take_tool_load`]).
+    pub load: LoadMean,
+}
+
+/// The mean of the tool's load over the samples since it was last taken: a control tick reads the
+/// mean of the (five, at 100 Hz) samples the 500 Hz stream brought since the last tick.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct LoadMean {
+    sum_n: f64,
+    count: u32,
+    last_n: Option<f64>,
+}
+
+impl LoadMean {
+    /// Adds one sample's load \[N\].
+    pub fn add(&mut self, load_n: f64) {
+        self.sum_n += load_n;
+        self.count += 1;
+    }
+
+    /// The mean since the last take (the last mean again when no sample came since), and starts
+    /// anew.
+    pub fn take(&mut self) -> Option<f64> {
+        if self.count > 0 {
+            self.last_n = Some(self.sum_n / f64::from(self.count));
+            (self.sum_n, self.count) = (0.0, 0);
+        }
+        self.last_n
+    }
 }
 
 /// A connected, started RTDE session.
@@ -148,6 +195,11 @@ impl UrClient {
         Ok(())
     }
 
+    /// The mean tool load \[N\] of the samples since the last call ([`LoadMean::take`]).
+    pub fn take_tool_load(&self) -> Option<f64> {
+        self.feed.lock().unwrap_or_else(|p| p.into_inner()).load.take()
+    }
+
     /// The latest sample and its age, or why the stream ended.
     pub fn latest(&self) -> Result<Option<(ArmSample, Duration)>, String> {
         let feed = self.feed.lock().unwrap_or_else(|p| p.into_inner());
@@ -203,12 +255,19 @@ async fn read_outputs(
     let why = loop {
         match session.feed(&mut buf) {
             Ok(events) => {
-                let latest = events.into_iter().rev().find_map(|e| match e {
-                    ClientEvent::Data { recipe_id, values } if recipe_id == recipe => decode_sample(&values),
-                    _ => None,
-                });
-                if let Some(s) = latest {
-                    feed.lock().unwrap_or_else(|p| p.into_inner()).latest = Some((s, Instant::now()));
+                let samples: Vec<ArmSample> = events
+                    .into_iter()
+                    .filter_map(|e| match e {
+                        ClientEvent::Data { recipe_id, values } if recipe_id == recipe => decode_sample(&values),
+                        _ => None,
+                    })
+                    .collect();
+                if let Some(s) = samples.last() {
+                    let mut feed = feed.lock().unwrap_or_else(|p| p.into_inner());
+                    for sample in &samples {
+                        feed.load.add(sample.tool_load_n());
+                    }
+                    feed.latest = Some((*s, Instant::now()));
                 }
             }
             Err(e) => break e.to_string(),
@@ -226,17 +285,25 @@ async fn read_outputs(
 pub fn decode_sample(values: &[RtdeValue]) -> Option<ArmSample> {
     use RtdeValue::*;
     match values {
-        [Double(t), Vector6d(q), Vector6d(qd), Vector6d(pose), Int32(mode), Int32(safety), Uint32(runtime)] => {
-            Some(ArmSample {
-                timestamp_s: *t,
-                q: *q,
-                qd: *qd,
-                tcp_pose: *pose,
-                robot_mode: *mode,
-                safety_mode: *safety,
-                runtime_state: *runtime,
-            })
-        }
+        [
+            Double(t),
+            Vector6d(q),
+            Vector6d(qd),
+            Vector6d(pose),
+            Int32(mode),
+            Int32(safety),
+            Uint32(runtime),
+            Vector6d(force),
+        ] => Some(ArmSample {
+            timestamp_s: *t,
+            q: *q,
+            qd: *qd,
+            tcp_pose: *pose,
+            robot_mode: *mode,
+            safety_mode: *safety,
+            runtime_state: *runtime,
+            tcp_force: *force,
+        }),
         _ => None,
     }
 }
@@ -249,4 +316,43 @@ pub async fn upload_program(addr: &str, program: &str) -> Result<(), String> {
         stream.write_all(b"\n").await.map_err(|e| format!("URScript {addr}: {e}"))?;
     }
     stream.shutdown().await.map_err(|e| format!("URScript {addr}: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sample_decodes_in_recipe_order_and_its_tool_load_is_minus_the_force_z() {
+        use RtdeValue::*;
+        let values = [
+            Double(1.5),
+            Vector6d([0.1; 6]),
+            Vector6d([0.0; 6]),
+            Vector6d([0.2; 6]),
+            Int32(7),
+            Int32(1),
+            Uint32(2),
+            Vector6d([0.5, -0.2, -3.44, 0.0, 0.0, 0.0]),
+        ];
+        assert_eq!(values.len(), OUTPUT_NAMES.len());
+        let s = decode_sample(&values).unwrap();
+        assert_eq!((s.timestamp_s, s.robot_mode, s.runtime_state), (1.5, 7, 2));
+        assert_eq!(s.tool_load_n(), 3.44);
+        // A recipe without the force (an older set-up) does not decode.
+        assert_eq!(decode_sample(&values[..7]), None);
+    }
+
+    #[test]
+    fn a_tick_takes_the_mean_load_of_the_samples_since_the_last_and_holds_it_when_none_came() {
+        let mut m = LoadMean::default();
+        assert_eq!(m.take(), None);
+        for load in [3.0, 3.5, 4.0, 3.5, 3.0] {
+            m.add(load);
+        }
+        assert_eq!(m.take(), Some(3.4));
+        assert_eq!(m.take(), Some(3.4));
+        m.add(1.0);
+        assert_eq!(m.take(), Some(1.0));
+    }
 }

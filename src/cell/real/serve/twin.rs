@@ -406,6 +406,8 @@ pub fn spawn(
                 o.actual_q = sample_q;
                 o.target_q = command.arm_q;
                 o.actual_tcp_pose = tcp_pose(&sample_q, &o.tcp_offset);
+                // The external force on the tool: the object's load pulls it down.
+                o.actual_tcp_force = [0.0, 0.0, -r.tool_load_n.unwrap_or(0.0), 0.0, 0.0, 0.0];
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
                 for (m, id) in motors.into_iter().enumerate() {
                     if let Some(t) = s.bus.table_mut(id) {
