@@ -193,11 +193,6 @@ impl SlipDetector {
         }
     }
 
-    /// The wrist's cue.
-    pub fn load_cue(&self) -> &LoadCue {
-        &self.load
-    }
-
     /// How many estimates the cues average for a reading noise of `noise_n` \[N\] (1 SD) and a
     /// setpoint of `reference_n`: enough that the fall's threshold is [`Z`] SDs of the difference
     /// of two averages, at most [`MAX_WINDOW_TICKS`] (1 at the paper's 3 pm noise).
