@@ -23,6 +23,7 @@
 //! - [`mujoco_log`]: MuJoCo's warnings into our log and summaries (no `MUJOCO_LOG.TXT`).
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
 //! - [`signals`]: the data types that cross the seam (wavelengths, ...).
+//! - [`ur5e`]: the arm's kinematics (UR's DH table), which the cell and the control side share.
 
 #![warn(missing_docs)]
 
@@ -43,4 +44,5 @@ pub mod sensor_bench;
 pub mod signals;
 pub mod study;
 pub mod sweep;
+pub mod ur5e;
 pub mod view;

@@ -103,6 +103,7 @@ fn plan(feedback: bool) -> ControlPlan {
         task,
         gripper: GripperConfig::default(),
         slip: SlipConfig::default(),
+        object_weight_n: None,
     }
 }
 

@@ -47,7 +47,7 @@ const ODD: [&str; 14] =
     ["0", "-1", "0.0", "-0.0", "1e-300", "\"\"", "\"x\"", "true", "[]", "[1.0, 2.0]", "{}", "1e9", "-1e9", "4.69"];
 
 /// Keys of the pick-and-place scenario beyond those the shipped files set.
-const KEYS: [&str; 39] = [
+const KEYS: [&str; 40] = [
     "seed",
     "setpoint_n",
     "control_rate_hz",
@@ -75,6 +75,7 @@ const KEYS: [&str; 39] = [
     "slip.lost_force_n",
     "slip.lost_hold_s",
     "slip.load_fall_fraction",
+    "slip.lift_check_m",
     "wrist.noise_n",
     "wrist.sample_rate_hz",
     "estimator.range_n",

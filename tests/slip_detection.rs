@@ -1,7 +1,8 @@
 //! The slip detector against the twin's ground truth (`control::slip`): it sees the drops the pad
 //! feels, stays quiet on a steady grip under a noisy interrogator, and, with the wrist's load
 //! (`control::load`), sees the falls the pad cannot: an object that drops after the pad has already
-//! lost it. Without the wrist sensor that stays a finding, kept true here too.
+//! lost it, and an object the hand never took up (a slick one). Without the wrist sensor the first
+//! stays a finding, kept true here too.
 
 use std::path::Path;
 use tendril::run::execute::run_on_twin;
@@ -80,6 +81,23 @@ fn without_feedback_the_wrist_sees_the_fall_the_pad_cannot() {
         let warned = s.slip_detected_s.unwrap_or_else(|| panic!("{object}: the pad's loss warns"));
         assert!(drop - warned > 1.0, "{object}: warned at {warned} s, drop at {drop} s");
     }
+}
+
+#[test]
+fn a_slick_object_the_hand_never_takes_up_is_seen_as_the_lift_leaves_it_behind() {
+    // Grip friction 0.05: the grip slides up the object, which stays on the table; the pad keeps its
+    // load and nothing the hand carried falls, so only the check of the object's weight once the
+    // hand has risen 20 mm sees it (0.85-1.5 s late before that check).
+    for object in ["crimper", "shampoo", "hammer"] {
+        let s = run(object, &["object.friction=0.05"]);
+        assert_eq!((s.outcome.as_str(), s.drop_phase.as_deref()), ("dropped", Some("lift")), "{object}");
+        let delay = s.drop_detection_delay_s.unwrap_or_else(|| panic!("{object}: drop not seen: {s:?}"));
+        assert!(delay <= 0.3, "{object}: seen {delay} s after the drop");
+        assert_eq!(s.false_alarms, Some(0), "{object}");
+    }
+    // Without the sensor nothing in the hand tells it.
+    let s = run("crimper", &["object.friction=0.05", "wrist.present=false"]);
+    assert!(s.drop_detection_delay_s.is_none_or(|d| d > 0.3), "{s:?}");
 }
 
 #[test]

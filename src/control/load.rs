@@ -26,6 +26,18 @@
 //! the fall it looks for, `f carried`, stands `Z` SDs of the `k`-reading mean clear of the noise:
 //! before that (nothing carried yet, an object too light for the sensor, or a cell without one)
 //! the pad's cues keep the drop alarm ([`super::slip::SlipDetector`]).
+//!
+//! The carried load is learnt from the readings, so an object the hand never took up (a slick one
+//! that stays on the table while the grip slides up it) shows no fall. For that the cue also
+//! checks the load against the object's weight `W` once the caller says the hand should carry it
+//! (the detector: once the hand has risen `slip.lift_check_m` since the carry began):
+//!
+//! ```text
+//! k_W   = clamp(ceil((Z σ / (f W))²), 1, LONG_WINDOW_TICKS)
+//! short = the mean of the last k_W readings ≤ (1 − f) W
+//! ```
+//!
+//! armed, like the fall, once `f W` stands `Z` SDs of the `k_W`-reading mean clear of the noise.
 
 use super::contact::{RunningStats, Z};
 use std::collections::VecDeque;
@@ -70,40 +82,70 @@ impl LoadCue {
 
     /// How many readings the fall is averaged over.
     pub fn window_ticks(&self) -> usize {
-        let fall = self.fall_fraction * self.carried_n;
-        let k = (Z * self.noise_n() / fall).powi(2).ceil();
-        if fall > 0.0 && k.is_finite() { (k as usize).clamp(1, LONG_WINDOW_TICKS) } else { LONG_WINDOW_TICKS }
+        self.ticks_to_see(self.fall_fraction * self.carried_n)
     }
 
     /// Whether the cue can see the fall it looks for (see the module docs).
     pub fn armed(&self) -> bool {
-        let fall = self.fall_fraction * self.carried_n;
-        self.home.count() >= 2 && fall > 0.0 && fall >= Z * self.noise_n() / (self.window_ticks() as f64).sqrt()
+        self.can_see(self.fall_fraction * self.carried_n)
     }
 
-    /// Takes one reading \[N\] while `carrying`; true while the load has fallen (and the cue is
-    /// armed). A missing or non-finite reading changes nothing. Outside the carry the window
-    /// empties and the carried load is forgotten.
-    pub fn update(&mut self, load_n: Option<f64>, carrying: bool) -> bool {
+    /// How many readings a change of `change_n` \[N\] is averaged over to stand [`Z`] SDs clear of
+    /// the noise (at most [`LONG_WINDOW_TICKS`]).
+    fn ticks_to_see(&self, change_n: f64) -> usize {
+        let k = (Z * self.noise_n() / change_n).powi(2).ceil();
+        if change_n > 0.0 && k.is_finite() { (k as usize).clamp(1, LONG_WINDOW_TICKS) } else { LONG_WINDOW_TICKS }
+    }
+
+    /// Whether a change of `change_n` \[N\] stands [`Z`] SDs clear of the noise of the mean it is
+    /// read from (and the noise has been learnt).
+    fn can_see(&self, change_n: f64) -> bool {
+        self.home.count() >= 2
+            && change_n > 0.0
+            && change_n >= Z * self.noise_n() / (self.ticks_to_see(change_n) as f64).sqrt()
+    }
+
+    /// The mean of the last `k` readings, once there are `k`.
+    fn recent_mean(&self, k: usize) -> Option<f64> {
+        (self.recent.len() >= k).then(|| self.recent.iter().rev().take(k).sum::<f64>() / k as f64)
+    }
+
+    /// Takes one reading \[N\] while `carrying`; `expected_n` is the object's weight \[N\] once the
+    /// hand should carry it (else `None`). A missing or non-finite reading changes nothing. Outside
+    /// the carry the window empties and the carried load is forgotten.
+    pub fn update(&mut self, load_n: Option<f64>, carrying: bool, expected_n: Option<f64>) -> LoadCues {
         if !carrying {
             self.recent.clear();
             self.carried_n = 0.0;
-            return false;
+            return LoadCues::default();
         }
-        let Some(load) = load_n.filter(|l| l.is_finite()) else { return false };
+        let Some(load) = load_n.filter(|l| l.is_finite()) else { return LoadCues::default() };
         let load = load - self.home.mean();
         self.recent.push_back(load);
         if self.recent.len() > LONG_WINDOW_TICKS {
             self.recent.pop_front();
         }
         self.carried_n += (load - self.carried_n) / LONG_WINDOW_TICKS as f64;
-        let k = self.window_ticks();
-        if !self.armed() || self.recent.len() < k {
-            return false;
-        }
-        let mean = self.recent.iter().rev().take(k).sum::<f64>() / k as f64;
-        mean <= (1.0 - self.fall_fraction) * self.carried_n
+        let keep = 1.0 - self.fall_fraction;
+        let fell =
+            self.armed() && self.recent_mean(self.window_ticks()).is_some_and(|mean| mean <= keep * self.carried_n);
+        let short = expected_n.is_some_and(|weight| {
+            let change = self.fall_fraction * weight;
+            self.can_see(change)
+                && self.recent_mean(self.ticks_to_see(change)).is_some_and(|mean| mean <= keep * weight)
+        });
+        LoadCues { fell, short }
     }
+}
+
+/// The wrist's cues on one reading.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LoadCues {
+    /// The load fell by `fall_fraction` of the carried load (the cue armed).
+    pub fell: bool,
+    /// The hand should carry the object, and the load is short of its weight by `fall_fraction`
+    /// or more (the check armed).
+    pub short: bool,
 }
 
 #[cfg(test)]
@@ -127,7 +169,7 @@ mod tests {
         let mut first = None;
         for (i, e) in gaussian(sigma, n, 17).into_iter().enumerate() {
             let t = i as f64 * 0.01;
-            if cue.update(Some(0.7 + load(t) + e), true) && first.is_none() {
+            if cue.update(Some(0.7 + load(t) + e), true, None).fell && first.is_none() {
                 first = Some(t);
             }
         }
@@ -158,11 +200,43 @@ mod tests {
     fn a_cell_without_the_sensor_or_outside_the_carry_never_alarms() {
         let mut cue = learnt(0.1);
         for _ in 0..200 {
-            assert!(!cue.update(None, true));
+            assert_eq!(cue.update(None, true, Some(3.4)), LoadCues::default());
         }
         for _ in 0..200 {
-            assert!(!cue.update(Some(3.0), false));
+            assert_eq!(cue.update(Some(3.0), false, Some(3.4)), LoadCues::default());
         }
         assert_eq!(cue.carried_n(), 0.0);
+    }
+
+    #[test]
+    fn an_object_the_hand_never_took_up_is_short_of_its_weight_once_it_should_carry_it() {
+        // A slick crimper (3.4 N) stays on the table: the wrist reads the grip's drag, 0.5 N. Until
+        // the hand should carry it nothing is short; from then on the check sees it at once.
+        let sigma = 0.78;
+        let mut cue = learnt(sigma);
+        let noise = gaussian(sigma, 300, 23);
+        let mut first_short = None;
+        for (i, e) in noise.iter().enumerate() {
+            let t = i as f64 * 0.01;
+            let expected = (t >= 2.0).then_some(3.4);
+            let cues = cue.update(Some(0.7 + 0.5 + e), true, expected);
+            assert!(!cues.fell, "nothing carried, nothing to fall from");
+            if cues.short && first_short.is_none() {
+                first_short = Some(t);
+            }
+        }
+        let seen = first_short.expect("the missing weight is seen");
+        assert!((2.0..2.1).contains(&seen), "{seen}");
+        // Carried, the same check stays quiet through the noise.
+        let mut carried = learnt(sigma);
+        for (i, e) in gaussian(sigma, 3000, 29).into_iter().enumerate() {
+            let expected = (i >= 200).then_some(3.4);
+            assert!(!carried.update(Some(0.7 + 3.4 + e), true, expected).short, "tick {i}");
+        }
+        // An object too light for the sensor never arms the check.
+        let mut light = learnt(sigma);
+        for e in gaussian(sigma, 300, 31) {
+            assert!(!light.update(Some(0.7 + e), true, Some(0.5)).short);
+        }
     }
 }

@@ -11,7 +11,8 @@
 //! - [`feedforward`]: the PID on a setpoint scheduled from the arm's planned motion.
 //! - [`slip_margin`]: a grip kept a margin above the friction limit of the planned load.
 //! - [`trajectory`]: joint-space moves within the paper's speed and acceleration limits.
-//! - [`slip`]: slip and loss detection from the force estimate.
+//! - [`slip`]: slip and drop detection from the force estimate and the wrist's load.
+//! - [`load`]: the wrist's cues (the carried load falling; the object's weight missing).
 
 pub mod contact;
 pub mod controller;
@@ -25,3 +26,6 @@ pub mod slip;
 pub mod slip_margin;
 pub mod task;
 pub mod trajectory;
+
+/// Standard gravity \[m/s²\] (ISO 80000-3), for the weights the control side reasons about.
+pub const G_M_S2: f64 = 9.80665;

@@ -13,7 +13,9 @@
 //! object's weight go, the pad's *loss* only warns of slip (the pad may lose an object that still
 //! hangs in the hand, and it cannot see one leave a grip whose pad keeps its load), while the pad's
 //! sudden *fall* still raises the alarm (a knock that sets the object sliding down the grip unloads
-//! the pad at once, and the wrist only as the slide speeds up).
+//! the pad at once, and the wrist only as the slide speeds up). And once the hand has risen
+//! `lift_check_m` since the carry began, the wrist must read the object's weight: an object the
+//! hand did not take up (a slick one left on the table) is a drop alarm then, though no load fell.
 //!
 //! Each alarm starts an episode; an episode ends once its cue has been clear for [`REARM_S`]. On
 //! the twin the episodes are judged against the ground truth ([`judge`]): the delay from the true
@@ -22,11 +24,11 @@
 //! What the pad cannot see: a drop while the pad is already unloaded (without feedback the shampoo
 //! hangs on the palm's pinch for seconds after the pad lost it), and an object sliding through a
 //! grip whose pad keeps its load (near-zero friction). What neither sees: an object that slides
-//! down the grip and stays in the hand (the knocked hammer). README, "Disturbances", has the
-//! figures.
+//! down the grip and stays in the hand (the knocked hammer), whose weight the hand still carries.
+//! README, "Disturbances", has the figures.
 
 use super::contact::{MAX_WINDOW_TICKS, Z};
-use super::load::LoadCue;
+use super::load::{LoadCue, LoadCues};
 use crate::scenario::{Checker, Validate};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -70,6 +72,12 @@ pub struct SlipConfig {
     /// of its weight; the carried load moves by a few percent with the arm's accelerations (the
     /// paper's 15 °/s² over the arm's reach of about 0.6 m: 0.16 m/s², under 2 % of g).
     pub load_fall_fraction: f64,
+    /// With a wrist force sensor, how far the hand must have risen since the carry began \[m\]
+    /// before the wrist must read the object's weight (short of it by `load_fall_fraction`: a drop
+    /// alarm). 0.02 m: an object the hand has not taken up after 20 mm of rise has slid 20 mm down
+    /// the grip, which is what the drop watch counts as a drop (`run::drop_watch`); the object's
+    /// weight moves onto the hand within the first few millimetres of a lift that carries it.
+    pub lift_check_m: f64,
 }
 
 impl Default for SlipConfig {
@@ -81,6 +89,7 @@ impl Default for SlipConfig {
             fall_fraction: 0.5,
             fall_window_s: 0.2,
             load_fall_fraction: 0.5,
+            lift_check_m: 0.02,
         }
     }
 }
@@ -108,6 +117,11 @@ impl Validate for SlipConfig {
         // and 0 would alarm on every tick.
         at.require("load_fall_fraction", self.load_fall_fraction > 0.0 && self.load_fall_fraction < 1.0, || {
             format!("must be > 0 and < 1, got {}", self.load_fall_fraction)
+        });
+        // 0.5 m: beyond any lift of the cell's task (the paper's is about 0.1 m), so the check
+        // would never run; 0 would check while the object still stands on the table.
+        at.require("lift_check_m", self.lift_check_m > 0.0 && self.lift_check_m <= 0.5, || {
+            format!("must be > 0 and at most 0.5 m, got {}", self.lift_check_m)
         });
     }
 }
@@ -153,6 +167,23 @@ impl Episodes {
     }
 }
 
+/// What the arm tells the detector on one tick.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ArmReading {
+    /// The wrist's reading of the load the tool carries \[N\] (`None`: no wrist sensor).
+    pub tool_load_n: Option<f64>,
+    /// The flange's height in the arm's base frame \[m\], from the measured joints
+    /// ([`crate::ur5e::forward`]).
+    pub hand_height_m: f64,
+}
+
+impl ArmReading {
+    /// The reading for the measured joint angles `arm_q` \[rad\] and the wrist's load.
+    pub fn from_joints(arm_q: &[f64; 6], tool_load_n: Option<f64>) -> ArmReading {
+        ArmReading { tool_load_n, hand_height_m: crate::ur5e::forward(arm_q).translation.vector.z }
+    }
+}
+
 /// Watches the force estimate during the phases in which the object must stay in the hand.
 #[derive(Debug, Clone)]
 pub struct SlipDetector {
@@ -168,6 +199,10 @@ pub struct SlipDetector {
     drop: Episodes,
     /// The wrist's cue (never armed on a cell without a wrist sensor).
     load: LoadCue,
+    /// The object's weight \[N\], when known: what the wrist must read once the hand has risen.
+    object_weight_n: Option<f64>,
+    /// The hand's height when the carry began \[m\].
+    carry_start_height_m: Option<f64>,
 }
 
 impl SlipDetector {
@@ -183,7 +218,16 @@ impl SlipDetector {
             warning: Episodes::default(),
             drop: Episodes::default(),
             load: LoadCue::new(config.load_fall_fraction),
+            object_weight_n: None,
+            carry_start_height_m: None,
         }
+    }
+
+    /// The detector, told the object's weight \[N\]: the wrist must read it once the hand has
+    /// risen `lift_check_m` (see the module docs).
+    pub fn with_object_weight(mut self, weight_n: f64) -> SlipDetector {
+        self.object_weight_n = Some(weight_n);
+        self
     }
 
     /// Learns the wrist's zero and noise from one reading at home (`None`: no wrist sensor).
@@ -205,23 +249,24 @@ impl SlipDetector {
         (k as usize).clamp(1, MAX_WINDOW_TICKS)
     }
 
-    /// Feeds one tick: the force estimate and the wrist's reading of the tool's load (`None`
-    /// without a wrist sensor). `unloaded_n` is what the estimator reads with nothing on the sensor
-    /// (the estimate at the tare) and `noise_n` the SD of the readings there; `holding` is true in
-    /// the phases where the object must stay in the hand; `reference_n` is the force the grasp
-    /// should have (the setpoint).
+    /// Feeds one tick: the force estimate and what the arm reads (the wrist's load, `None` without
+    /// a wrist sensor, and the hand's height). `unloaded_n` is what the estimator reads with nothing
+    /// on the sensor (the estimate at the tare) and `noise_n` the SD of the readings there;
+    /// `holding` is true in the phases where the object must stay in the hand; `reference_n` is
+    /// the force the grasp should have (the setpoint).
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         time_s: f64,
         force_n: f64,
-        load_n: Option<f64>,
+        arm: ArmReading,
         unloaded_n: f64,
         noise_n: f64,
         reference_n: f64,
         holding: bool,
     ) -> SlipEvents {
-        let load_fell = self.load.update(load_n, holding);
+        let expected_n = self.expected_load_n(arm.hand_height_m, holding);
+        let load = self.load.update(arm.tool_load_n, holding, expected_n);
         if !holding {
             self.below_since = None;
             self.recent.clear();
@@ -233,7 +278,7 @@ impl SlipDetector {
         // hangs on the pinch). The pad's sudden fall stays an alarm: something moved the object in
         // the hand, and a slide the wrist sees only once it speeds up may follow.
         let wrist = self.load.armed();
-        let drop_on = if wrist { load_fell || pad.fell } else { pad.fell || pad.lost };
+        let drop_on = load.short || if wrist { load.fell || pad.fell } else { pad.fell || pad.lost };
         if self.warning.update(time_s, pad.below_slip || (wrist && pad.lost)) {
             self.alarms.warnings_s.push(time_s);
         }
@@ -245,13 +290,24 @@ impl SlipDetector {
             self.events.drop_alarm_s = self.alarms.drops_s.last().copied();
         }
         if self.events.dropped_s.is_none() {
-            self.events.dropped_s = match (wrist, load_fell, pad.lost) {
-                (true, true, _) => Some(time_s),
+            self.events.dropped_s = match (wrist, load, pad.lost) {
+                (_, LoadCues { short: true, .. }, _) | (true, LoadCues { fell: true, .. }, _) => Some(time_s),
                 (false, _, true) => self.events.lost_s,
                 _ => None,
             };
         }
         self.events
+    }
+
+    /// The load the wrist must read this tick \[N\]: the object's weight once the hand has risen
+    /// `lift_check_m` above where the carry began, else `None`.
+    fn expected_load_n(&mut self, hand_height_m: f64, holding: bool) -> Option<f64> {
+        if !holding {
+            self.carry_start_height_m = None;
+            return None;
+        }
+        let start = *self.carry_start_height_m.get_or_insert(hand_height_m);
+        self.object_weight_n.filter(|_| hand_height_m - start >= self.config.lift_check_m)
     }
 
     /// The pad's cues this tick (all off once the pad has lost the object).
@@ -346,7 +402,7 @@ mod tests {
         for i in 0..1000 {
             let t = i as f64 * 0.01;
             let f = if t < 2.0 { 1.6 } else { (1.6 * (1.0 - (t - 2.0) / 4.0)).max(0.0) };
-            d.update(t, f, None, 0.0, 0.0, 1.6, true);
+            d.update(t, f, ArmReading::default(), 0.0, 0.0, 1.6, true);
         }
         let e = d.events();
         assert!((e.slip_start_s.unwrap() - 4.0).abs() < 0.02, "{e:?}");
@@ -359,11 +415,11 @@ mod tests {
         for i in 0..100 {
             let t = i as f64 * 0.01;
             let f = if i % 10 == 0 { 0.0 } else { 1.0 };
-            d.update(t, f + 0.16, None, 0.16, 0.0, 1.0, true);
+            d.update(t, f + 0.16, ArmReading::default(), 0.16, 0.0, 1.0, true);
         }
         assert_eq!(d.events().lost_s, None);
-        d.update(1.0, 0.0, None, 0.0, 0.0, 1.0, false);
-        d.update(2.0, 0.0, None, 0.0, 0.0, 1.0, false);
+        d.update(1.0, 0.0, ArmReading::default(), 0.0, 0.0, 1.0, false);
+        d.update(2.0, 0.0, ArmReading::default(), 0.0, 0.0, 1.0, false);
         assert_eq!(d.events().lost_s, None);
     }
 
@@ -372,7 +428,7 @@ mod tests {
         let n = (seconds * 100.0) as usize;
         for (i, e) in crate::control::contact::gaussian(sigma, n, 11).into_iter().enumerate() {
             let t = i as f64 * 0.01;
-            d.update(t, f(t) + e, None, 0.16, sigma, 0.6, true);
+            d.update(t, f(t) + e, ArmReading::default(), 0.16, sigma, 0.6, true);
         }
     }
 
@@ -407,7 +463,8 @@ mod tests {
         }
         for (i, e) in crate::control::contact::gaussian(0.78, 1000, 9).into_iter().enumerate() {
             let t = i as f64 * 0.01;
-            d.update(t, pad(t), Some(load(t) + e), 0.16, 0.0, 0.6, true);
+            let arm = ArmReading { tool_load_n: Some(load(t) + e), hand_height_m: 0.0 };
+            d.update(t, pad(t), arm, 0.16, 0.0, 0.6, true);
         }
         d
     }
@@ -435,13 +492,48 @@ mod tests {
         assert_eq!(d.events().dropped_s, None, "the hand still carries the object");
     }
 
+    /// A detector that learnt the wrist's noise at home and was told a 3.4 N object, fed 6 s of
+    /// the hand rising at 10 mm/s from 1 s, a steady pad, and a wrist reading of `load(height)`.
+    fn lifting(weight_known: bool, load: impl Fn(f64) -> f64) -> SlipDetector {
+        let mut d = SlipDetector::new(SlipConfig::default());
+        if weight_known {
+            d = d.with_object_weight(3.4);
+        }
+        for e in crate::control::contact::gaussian(0.78, 50, 5) {
+            d.observe_home_load(Some(e));
+        }
+        for (i, e) in crate::control::contact::gaussian(0.78, 600, 13).into_iter().enumerate() {
+            let t = i as f64 * 0.01;
+            let rise_m = 0.01 * (t - 1.0).max(0.0);
+            let arm = ArmReading { tool_load_n: Some(load(rise_m) + e), hand_height_m: 0.4 + rise_m };
+            d.update(t, 0.76, arm, 0.16, 0.0, 0.6, true);
+        }
+        d
+    }
+
+    #[test]
+    fn an_object_the_hand_did_not_take_up_is_a_drop_once_the_hand_has_risen_the_lift_check() {
+        // A slick object stays on the table: the wrist reads the grip's 0.5 N drag, the pad keeps
+        // its load. The hand passes 20 mm at 3 s.
+        let slick = lifting(true, |_| 0.5);
+        assert_eq!(slick.alarms().drops_s.len(), 1, "{:?}", slick.alarms());
+        assert!((3.0..3.1).contains(&slick.alarms().drops_s[0]), "{:?}", slick.alarms());
+        assert_eq!(slick.events().dropped_s, Some(slick.alarms().drops_s[0]));
+        // Taken up within the first 3 mm, the same lift raises nothing.
+        let carried = lifting(true, |rise| 3.4 * (rise / 0.003).min(1.0));
+        assert!(carried.alarms().drops_s.is_empty(), "{:?}", carried.alarms());
+        // Without the object's weight the detector cannot know what the hand should carry.
+        let unknown = lifting(false, |_| 0.5);
+        assert!(unknown.alarms().drops_s.is_empty(), "{:?}", unknown.alarms());
+    }
+
     #[test]
     fn without_a_wrist_reading_the_pads_loss_is_the_drop() {
         let mut d = SlipDetector::new(SlipConfig::default());
         d.observe_home_load(None);
         for i in 0..600 {
             let t = i as f64 * 0.01;
-            d.update(t, if t < 3.0 { 0.76 } else { 0.16 }, None, 0.16, 0.0, 0.6, true);
+            d.update(t, if t < 3.0 { 0.76 } else { 0.16 }, ArmReading::default(), 0.16, 0.0, 0.6, true);
         }
         let events = d.events();
         assert!(events.lost_s.is_some_and(|t| (3.0..3.05).contains(&t)), "{events:?}");

@@ -28,13 +28,11 @@
 //! instantaneous load would always be late. The feedforward term lets the grip follow the ramp of
 //! F* without the integrating loop's ramp error.
 
+use super::G_M_S2;
 use super::controller::{ControlContext, ForceController};
 use super::pid::{Pid, PidConfig};
 use crate::scenario::{Checker, Validate};
 use serde::{Deserialize, Serialize};
-
-/// Standard gravity [m/s²].
-const G_M_S2: f64 = 9.80665;
 
 /// The slip-margin controller's keys (TOML `[controller]` with `type = "slip_margin"`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -8,7 +8,7 @@ use super::trace::{TraceRow, TraceWriter};
 use crate::control::controller::{ControllerConfig, ForceController};
 use crate::control::estimate::{Estimate, EstimateError, ForceCalibration, ForceEstimator};
 use crate::control::gripper::GripperConfig;
-use crate::control::slip::{Alarms, Judgement, SlipConfig, SlipDetector, SlipEvents, judge};
+use crate::control::slip::{Alarms, ArmReading, Judgement, SlipConfig, SlipDetector, SlipEvents, judge};
 use crate::control::task::{Phase, TaskConfig, TaskSequencer};
 use crate::hardware::{Cell, CellError};
 use crate::signals::Wavelengths;
@@ -33,6 +33,9 @@ pub struct ControlPlan {
     pub gripper: GripperConfig,
     /// Slip detector thresholds.
     pub slip: SlipConfig,
+    /// The object's weight \[N\], when known (its mass from the scenario): what the wrist must read
+    /// once the lift is under way ([`SlipDetector::with_object_weight`]).
+    pub object_weight_n: Option<f64>,
 }
 
 /// How a run ended.
@@ -130,6 +133,9 @@ pub fn run_task_observed(
     let mut sequencer = TaskSequencer::new(plan.task.clone(), plan.gripper, controller, plan.setpoint_n, plan.feedback);
     let mut invalid = InvalidSamples::default();
     let mut slip = SlipDetector::new(plan.slip);
+    if let Some(weight) = plan.object_weight_n {
+        slip = slip.with_object_weight(weight);
+    }
     let mut drop_watch = DropWatch::default();
     let mut truth_drop: Option<Drop> = None;
     let mut dropped_samples = 0u64;
@@ -189,7 +195,7 @@ pub fn run_task_observed(
             slip.update(
                 state.time_s,
                 estimate.force_n,
-                state.tool_load_n,
+                ArmReading::from_joints(&state.arm_q, state.tool_load_n),
                 unloaded_n,
                 sequencer.reading_noise_n(),
                 plan.setpoint_n,

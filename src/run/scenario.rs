@@ -196,9 +196,7 @@ impl PickPlaceScenario {
         RunIdentity {
             scenario: self.name.clone(),
             object: self.object.label(),
-            // The override, else the object's model file (NaN only if it does not load, when no run
-            // can start).
-            mass_kg: self.object.mass_kg.unwrap_or_else(|| self.object.model().map_or(f64::NAN, |m| m.mass_kg)),
+            mass_kg: self.object_mass_kg(),
             feedback: self.feedback,
             controller_type: self.controller.type_name().into(),
             // A controller without PID gains reports none (NaN, `null` in the summary).
@@ -213,6 +211,12 @@ impl PickPlaceScenario {
         }
     }
 
+    /// The object's mass \[kg\]: the override, else the object's model file (NaN only if it does
+    /// not load, when no run can start).
+    pub fn object_mass_kg(&self) -> f64 {
+        self.object.mass_kg.unwrap_or_else(|| self.object.model().map_or(f64::NAN, |m| m.mass_kg))
+    }
+
     /// What the control side needs.
     pub fn control_plan(&self) -> ControlPlan {
         ControlPlan {
@@ -224,6 +228,7 @@ impl PickPlaceScenario {
             task: self.task.clone(),
             gripper: self.gripper,
             slip: self.slip,
+            object_weight_n: Some(self.object_mass_kg() * crate::control::G_M_S2).filter(|w| w.is_finite()),
         }
     }
 }

@@ -23,9 +23,10 @@ pub mod rapier;
 pub mod scene;
 pub mod strip;
 pub mod template;
-pub mod ur5e;
 pub mod validation;
 
+/// The arm's kinematics, shared with the control side ([`crate::ur5e`]).
+pub use crate::ur5e;
 pub use compose::Placement;
 pub use config::{
     ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig, Solver,

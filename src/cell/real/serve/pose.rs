@@ -8,7 +8,7 @@
 //! `tool0`). No offset is needed between them: at all joints zero the flange is at
 //! (a2 + a3, −d4 − d6, d1 − d5), as on the pendant.
 
-use crate::cell::physics::ur5e;
+use crate::ur5e;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 /// `[x, y, z, rx, ry, rz]` of a pose: translation \[m\] and rotation vector \[rad\] (angle in [0, π]).

@@ -5,10 +5,10 @@
 use super::interp::{Controller, DigitalOut};
 use super::motion::Arm;
 use super::value::Value;
-use crate::cell::physics::ur5e;
 use crate::cell::real::protocol::rtde::fields::REGISTER_COUNT;
 use crate::cell::real::serve::pose::{pose_from_vector, pose_vector, tcp_pose};
 use crate::cell::real::urscript::{RtdeWatchdog, WatchdogAction};
+use crate::ur5e;
 
 /// What a built-in gives back.
 #[derive(Debug, Clone, PartialEq)]

@@ -24,9 +24,9 @@
 //!
 //! Speeds are capped at the UR5e's joint speed (π rad/s), the protective-stop limit.
 
-use crate::cell::physics::ur5e;
 use crate::cell::real::serve::pose::{pose_from_vector, pose_vector};
 use crate::cell::real::serve::safety::MAX_JOINT_SPEED_RAD_S;
+use crate::ur5e;
 use nalgebra::{Isometry3, Translation3};
 
 /// Lever that turns a tool acceleration into a joint one for `stopl` \[m\].

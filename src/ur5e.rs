@@ -1,5 +1,6 @@
 //! UR5e kinematics from UR's DH table (hardware.md): forward kinematics to the tool flange and a
-//! damped-least-squares inverse near a seed, for the kinematic arm mode and for planning poses.
+//! damped-least-squares inverse near a seed, for the kinematic arm mode, for planning poses and for
+//! the slip detector's hand height ([`crate::control::slip`]).
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
 
