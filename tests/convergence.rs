@@ -42,10 +42,7 @@ fn the_quick_study_judges_its_own_rows_by_the_criteria() {
     let settings: Vec<(&str, &str, &str)> =
         rows.iter().map(|r| (r["setting"].as_str(), r["timestep_s"].as_str(), r["segments"].as_str())).collect();
     assert_eq!(settings.len(), 6, "two cases at three settings");
-    assert_eq!(
-        &settings[..3],
-        [("default", "0.00125", "8"), ("step/2", "0.000625", "8"), ("links x2", "0.00125", "16")]
-    );
+    assert_eq!(&settings[..3], [("default", "0.0025", "8"), ("step/2", "0.00125", "8"), ("links x2", "0.0025", "16")]);
     let verdicts = read(&dir.path().join("convergence_criteria.csv"));
     assert_eq!(verdicts.len(), 4, "two cases, two pairs each");
     let mut broken = 0;

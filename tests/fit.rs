@@ -11,8 +11,8 @@ use common::cli::{stderr, tendril, tendril_command};
 const SCENARIO: &str = "scenarios/short-lift.toml";
 
 /// The fit's machinery is under test here, not the physics: the recordings, and so every candidate
-/// (which re-runs a recording's own scenario), use 32 uniform links at a 5 ms step, about 3x faster
-/// than the converged default (1.25 ms, the graded 8-link finger). README, "Fit to the paper",
+/// (which re-runs a recording's own scenario), use 32 uniform links at a 5 ms step, about twice as
+/// fast as the converged default (2.5 ms, the graded 8-link finger). README, "Fit to the paper",
 /// scores the default itself.
 const QUICK_NUMERICS: [&str; 6] =
     ["--set", "finger.segments=32", "--set", "finger.base_refinement=1", "--set", "physics.timestep_s=0.005"];

@@ -150,8 +150,8 @@ fn int(v: &RtdeValue) -> i64 {
 fn tcp_pose_follows_actual_q_and_actual_qd_is_the_derivative_of_actual_q() {
     let _turn = one_at_a_time();
     // A 5 ms physics step, so that two or three 2 ms RTDE samples fall inside each step, where
-    // actual_qd is constant and the derivative check below applies (at the default 1.25 ms step
-    // no two samples share a step).
+    // actual_qd is constant and the derivative check below applies (at the default 2.5 ms step
+    // a step holds one sample or two).
     let serve =
         start(&short_lift(&["physics.timestep_s=0.005"]), &ServeConfig::loopback().with_port_base(21800)).unwrap();
     upload(&serve, FOLLOW_SCRIPT);

@@ -188,8 +188,8 @@ pub enum ArmMode {
     /// over the tick), with the setpoint's velocity fed forward, as the UR's own joint controller
     /// tracks its interpolated trajectory; the hand gives way to contact forces through the servos'
     /// stiffness. MuJoCo's default: its answers hold from the default step down (the shampoo's drop
-    /// without feedback 13.83 / 13.90 / 13.91 s at 1.25 / 0.625 / 0.3125 ms, seed 1; README,
-    /// "Convergence"), as fast as the prescribed arm (18-20x real time against 16-19x).
+    /// without feedback 13.63 / 13.83 / 13.90 s at 2.5 / 1.25 / 0.625 ms, seed 1; README,
+    /// "Convergence"), as fast as the prescribed arm (at 1.25 ms 18-20x real time against 16-19x).
     Dynamic,
 }
 
@@ -208,8 +208,9 @@ impl ArmMode {
 /// Defaults are the converged setting (README, "Convergence"): elliptic cones and a Newton solver with
 /// a small tolerance (MuJoCo's advice for slip accuracy; modeling.md measured that pyramidal cones
 /// creep), stiff contacts that hold objects without noslip iterations, and the largest step at which
-/// the Section V answers agree with half that step. About 20x real time on one core with the default
-/// graded finger (benches/scenario.rs; README, "Speed and accuracy").
+/// the Section V answers agree with half that step and the contacts keep their time constant. About
+/// 30x real time on one core with the default graded finger (benches/scenario.rs; README, "Speed
+/// and accuracy").
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
@@ -221,11 +222,14 @@ pub struct PhysicsConfig {
     /// copies built into the binary.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub models_dir: Option<PathBuf>,
-    /// Simulation step \[s\]. 1.25 ms: the largest step whose Section V answers agree with half the
-    /// step by the convergence criteria (drops within 0.25 s, fluctuations within 3 points, seed 1);
-    /// at 2.5 ms the shampoo's fluctuation with feedback is 8 points off. It is also four steps of
-    /// the 5 ms contact time constant, so the contact dynamics are resolved, not clamped to
-    /// MuJoCo's two-step minimum. A numerical choice, not a calibration knob (README, "Convergence").
+    /// Simulation step \[s\]. 2.5 ms: the largest step at which the 5 ms contacts below keep
+    /// their time constant (MuJoCo stretches a time constant shorter than two steps to two steps, so
+    /// at 5 ms the contacts would be 10 ms ones, a different contact model), and whose Section V
+    /// answers agree with half and a quarter of the step by the convergence criteria (seeds 1-3:
+    /// drops within 0.25 s, rises within 0.1 s, fluctuations within 1.1 points; README,
+    /// "Convergence"). Half the cost of 1.25 ms, the default before: that was chosen on the
+    /// prescribed arm, whose shampoo fluctuation moved 8 points at 2.5 ms; with the servoed arm it
+    /// moves 0.7. A numerical choice, not a calibration knob.
     pub timestep_s: f64,
     /// Integrator. `implicitfast`: the creep dashpot (thousands of N s/m on a 1 g node) and the servos'
     /// `kv` are integrated implicitly, which explicit Euler would not survive at this step.
@@ -262,10 +266,10 @@ pub struct PhysicsConfig {
     pub noslip_tolerance: f64,
     /// Contact solref time constant \[s\] (global default): stiffness of contacts. 5 ms: stiff enough
     /// that soft-contact creep does not let a held object slide without noslip (the slope and pinch
-    /// tests in tests/physics_validation.rs pass with noslip off), and four steps at the 1.25 ms
-    /// default, so the contact dynamics are resolved by the integrator instead of being clamped to
-    /// MuJoCo's two-step minimum. A numerical stiffness of the soft-contact model, not a material
-    /// property: at 0.625 ms (eight steps) the Section V answers are the default's.
+    /// tests in tests/physics_validation.rs pass with noslip off), and two steps at the 2.5 ms
+    /// default, MuJoCo's least (a shorter one is stretched to two steps). A numerical stiffness of
+    /// the soft-contact model, not a material property: at 1.25 and 0.625 ms (four and eight steps)
+    /// the Section V answers are the default's.
     pub contact_timeconst_s: f64,
     /// Contact solref damping ratio (1 = critical).
     pub contact_dampratio: f64,
@@ -304,7 +308,7 @@ impl Default for PhysicsConfig {
     fn default() -> Self {
         PhysicsConfig {
             backend: Backend::Mujoco,
-            timestep_s: 0.00125,
+            timestep_s: 0.0025,
             integrator: Integrator::Implicitfast,
             cone: Cone::Elliptic,
             impratio: 3.0,

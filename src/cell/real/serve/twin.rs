@@ -204,14 +204,14 @@ pub fn open_bus(
 /// The arm RTDE reports at twin time `t` \[s\]: interpolated linearly between the physics states
 /// `before` and `after` (time \[s\], joints \[rad\]), `t` clamped to the span between them.
 ///
-/// Why: the physics moves the arm once per step (5 ms), so reporting the latest step gave a 500 Hz
-/// client the same sample in two or three packages running. Within a step (1.25 ms) the arm moves
+/// Why: the physics moves the arm once per step (2.5 ms at the default), so reporting the latest
+/// step gave a 500 Hz client the same sample in two packages running. Within a step the arm moves
 /// at nearly a constant rate (exactly so with `physics.arm_mode = "kinematic"`; the servoed arm's
 /// speed changes by a step's acceleration), so the interpolation is its path. The physics steps once a
 /// tick's wait passes half of the step (`wait_until`), so the latest step ends within half a step
 /// of the twin's clock either way; at half a step behind the clock the sample is always between
 /// the last two steps: an interpolation, never an extrapolation. The cost: RTDE's samples are half a
-/// step (2.5 ms) older than before on average, and each is stamped with its own time.
+/// step older on average, and each is stamped with its own time.
 fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64, [f64; 6]) {
     let span = after.0 - before.0;
     if span <= 0.0 {
@@ -239,8 +239,8 @@ impl Tracking {
     /// A `servoj` target: reached one program cycle after it is given, at a constant speed from
     /// where the previous target left the arm (servoj's `t` of one cycle). Commanding the target at
     /// the next physics step instead made the arm's speed depend on how many steps fell in each
-    /// cycle: with 1.25 ms steps and 2 ms cycles it moved one cycle's way in 1.25 ms, then in
-    /// 2.5 ms, and the shaking let a held crimper go in the short lift (the estimate 0.15-1.6 N
+    /// cycle: with 1.25 ms steps and 2 ms cycles (the default step then) it moved one cycle's way in
+    /// 1.25 ms, then in 2.5 ms, and the shaking let a held crimper go in the short lift (the estimate 0.15-1.6 N
     /// against 0.53-0.58 N on the simulated path; measured).
     fn servo(from: [f64; 6], to: [f64; 6], now_s: f64) -> Tracking {
         let qd = std::array::from_fn(|j| (to[j] - from[j]) / CONTROL_PERIOD_S);
