@@ -226,7 +226,7 @@ pub struct PhysicsConfig {
     /// their time constant (MuJoCo stretches a time constant shorter than two steps to two steps, so
     /// at 5 ms the contacts would be 10 ms ones, a different contact model), and whose Section V
     /// answers agree with half and a quarter of the step by the convergence criteria (seeds 1-3:
-    /// drops within 0.25 s, rises within 0.1 s, fluctuations within 1.1 points; README,
+    /// drops within 0.29 s, rises within 0.1 s, fluctuations within 1.4 points; README,
     /// "Convergence"). Half the cost of 1.25 ms, the default before: that was chosen on the
     /// prescribed arm, whose shampoo fluctuation moved 8 points at 2.5 ms; with the servoed arm it
     /// moves 0.7. A numerical choice, not a calibration knob.
