@@ -273,8 +273,9 @@ pub struct PhysicsReadout {
     /// The object's vertical load on the arm \[N\]: the upward (world +z) component of every
     /// contact force the arm and what it carries (links, hand, palm, strip, pad) exert on the
     /// object, so an object hanging still in the grip reads its weight. What the arm's wrist force
-    /// sensor adds to the tool's own load ([`crate::cell::wrist`]). `None` where the backend does
-    /// not resolve contact forces into vectors (rapier).
+    /// sensor adds to the tool's own load ([`crate::cell::wrist`]). MuJoCo sums its contact forces;
+    /// rapier, whose friction impulses stay inside its solver, takes it from the object's momentum
+    /// over the step. `None` where a backend cannot tell it.
     pub tool_load_n: Option<f64>,
 }
 

@@ -15,6 +15,11 @@ pub struct RapierScene {
     shared: Arc<SceneModel>,
     world: RapierWorld,
     drive: Drive,
+    /// Every geom that can touch the object and is neither the object's nor carried by the arm:
+    /// the table.
+    support_geoms: Vec<usize>,
+    /// The vertical force the arm's geoms exerted on the object over the last step \[N\].
+    tool_load_n: f64,
 }
 
 fn to_na(v: Vector) -> Vector3<f64> {
@@ -39,12 +44,26 @@ impl RapierScene {
             world.place_joint(*j, q);
         }
         let drive = Drive::new(&shared.spec().physics, &shared.spec().finger, q0);
-        Ok(RapierScene { shared, world, drive })
+        let ngeom = shared.model().ffi().ngeom as usize;
+        let support_geoms =
+            (0..ngeom).filter(|g| !ids.hand_geoms.contains(g) && !ids.object_geoms.contains(g)).collect();
+        Ok(RapierScene { shared, world, drive, support_geoms, tool_load_n: 0.0 })
     }
 
     /// The rapier world (read-only), for checks beyond the readout.
     pub fn world(&self) -> &RapierWorld {
         &self.world
+    }
+
+    /// The upward force the arm's geoms exerted on object body `b` over the step just taken \[N\],
+    /// from its momentum: m Δv_z / dt = F_arm + F_support + m g_z. Rapier's contact solve gives
+    /// impulses whose friction directions are internal to its solver, so the force is read from
+    /// what it did to the object instead; the support (the table) is taken as horizontal, its
+    /// contacts' force vertical. With `vz_before_m_s` the object's vertical velocity before the step.
+    fn load_on_object(&self, b: usize, vz_before_m_s: f64, dt: f64) -> f64 {
+        let (v, mass) = self.world.body_momentum(b);
+        let (support_n, _) = self.world.normal_force_between(&self.support_geoms, &self.shared.ids().object_geoms);
+        mass * ((v.z - vz_before_m_s) / dt - self.world.gravity().z) - support_n
     }
 }
 
@@ -110,7 +129,12 @@ impl Physics for RapierScene {
             let v = (set.arm_q[k] - self.world.joint_position(*j)) / dt;
             self.world.set_joint_velocity(*j, v);
         }
-        self.world.step()
+        let before = ids.object_body.map(|b| self.world.body_momentum(b).0.z);
+        self.world.step()?;
+        if let (Some(b), Some(vz_before)) = (ids.object_body, before) {
+            self.tool_load_n = self.load_on_object(b, vz_before, dt);
+        }
+        Ok(())
     }
 
     fn readout(&self) -> PhysicsReadout {
@@ -136,6 +160,7 @@ impl Physics for RapierScene {
             tendon_tension_n: w.tendon_tension(ids.tendon_elastic).max(0.0)
                 + w.tendon_tension(ids.tendon_maxwell).max(0.0),
             arm_q: ids.arm_joint.map(|j| w.joint_position(j)),
+            tool_load_n: Some(self.tool_load_n),
             ..PhysicsReadout::default()
         };
         if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {

@@ -167,6 +167,17 @@ impl RapierWorld {
         *self.world.bodies[self.bodies[b]].position()
     }
 
+    /// Velocity of body `b`'s centre of mass \[m/s\] and its mass \[kg\].
+    pub fn body_momentum(&self, b: usize) -> (Vector, f64) {
+        let rb = &self.world.bodies[self.bodies[b]];
+        (rb.linvel(), rb.mass())
+    }
+
+    /// Gravity \[m/s²\].
+    pub fn gravity(&self) -> Vector {
+        self.world.gravity
+    }
+
     /// Velocity of the point `p` (world frame) attached to body `b` [m/s], and the body's angular
     /// velocity [rad/s].
     pub fn point_velocity(&self, b: usize, p: Vector) -> (Vector, Vector) {
