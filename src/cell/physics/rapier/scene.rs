@@ -18,8 +18,9 @@ pub struct RapierScene {
     /// Every geom that can touch the object and is neither the object's nor carried by the arm:
     /// the table.
     support_geoms: Vec<usize>,
-    /// The vertical force the arm's geoms exerted on the object over the last step \[N\].
-    tool_load_n: f64,
+    /// The object's vertical velocity before the last step \[m/s\], for the load over that step
+    /// (`None` before the first step or without an object).
+    object_vz_before_m_s: Option<f64>,
 }
 
 fn to_na(v: Vector) -> Vector3<f64> {
@@ -47,7 +48,7 @@ impl RapierScene {
         let ngeom = shared.model().ffi().ngeom as usize;
         let support_geoms =
             (0..ngeom).filter(|g| !ids.hand_geoms.contains(g) && !ids.object_geoms.contains(g)).collect();
-        Ok(RapierScene { shared, world, drive, support_geoms, tool_load_n: 0.0 })
+        Ok(RapierScene { shared, world, drive, support_geoms, object_vz_before_m_s: None })
     }
 
     /// The rapier world (read-only), for checks beyond the readout.
@@ -55,15 +56,17 @@ impl RapierScene {
         &self.world
     }
 
-    /// The upward force the arm's geoms exerted on object body `b` over the step just taken \[N\],
-    /// from its momentum: m Δv_z / dt = F_arm + F_support + m g_z. Rapier's contact solve gives
-    /// impulses whose friction directions are internal to its solver, so the force is read from
-    /// what it did to the object instead; the support (the table) is taken as horizontal, its
-    /// contacts' force vertical. With `vz_before_m_s` the object's vertical velocity before the step.
-    fn load_on_object(&self, b: usize, vz_before_m_s: f64, dt: f64) -> f64 {
+    /// The upward force the arm's geoms exerted on the object over the last step \[N\], from its
+    /// momentum: m Δv_z / dt = F_arm + F_support + m g_z (`None` before the first step or without
+    /// an object). Rapier's contact solve gives impulses whose friction directions are internal to
+    /// its solver, so the force is read from what it did to the object instead; the support (the
+    /// table) is taken as horizontal, its contacts' force vertical.
+    fn load_on_object(&self) -> Option<f64> {
+        let (vz_before, b) = (self.object_vz_before_m_s?, self.shared.ids().object_body?);
         let (v, mass) = self.world.body_momentum(b);
         let (support_n, _) = self.world.normal_force_between(&self.support_geoms, &self.shared.ids().object_geoms);
-        mass * ((v.z - vz_before_m_s) / dt - self.world.gravity().z) - support_n
+        let dv_dt = (v.z - vz_before) / self.world.timestep();
+        Some(mass * (dv_dt - self.world.gravity().z) - support_n)
     }
 }
 
@@ -129,12 +132,8 @@ impl Physics for RapierScene {
             let v = (set.arm_q[k] - self.world.joint_position(*j)) / dt;
             self.world.set_joint_velocity(*j, v);
         }
-        let before = ids.object_body.map(|b| self.world.body_momentum(b).0.z);
-        self.world.step()?;
-        if let (Some(b), Some(vz_before)) = (ids.object_body, before) {
-            self.tool_load_n = self.load_on_object(b, vz_before, dt);
-        }
-        Ok(())
+        self.object_vz_before_m_s = ids.object_body.map(|b| self.world.body_momentum(b).0.z);
+        self.world.step()
     }
 
     fn readout(&self) -> PhysicsReadout {
@@ -160,7 +159,7 @@ impl Physics for RapierScene {
             tendon_tension_n: w.tendon_tension(ids.tendon_elastic).max(0.0)
                 + w.tendon_tension(ids.tendon_maxwell).max(0.0),
             arm_q: ids.arm_joint.map(|j| w.joint_position(j)),
-            tool_load_n: Some(self.tool_load_n),
+            tool_load_n: Some(self.load_on_object().unwrap_or(0.0)),
             ..PhysicsReadout::default()
         };
         if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {
