@@ -305,6 +305,25 @@ fn tune_finds_gains_per_object_and_writes_an_overlay_that_run_takes() {
     assert!(!o.status.success() && stderr(&o).contains("controller.kq"), "{}", stderr(&o));
 }
 
+/// Every tune file the repository ships is one `tendril tune` accepts: its scenarios, keys, bounds,
+/// controller types and disturbance sets are checked as a user's would be, without running.
+#[test]
+fn the_shipped_tune_files_load() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/fit");
+    let mut loaded = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with("tune-") && name.ends_with(".toml") {
+            tendril::fit::tune::load_tune(&path, &tendril::scenario::Overlay::default())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            loaded.push(name);
+        }
+    }
+    loaded.sort();
+    assert_eq!(loaded, ["tune-gains.toml", "tune-paper-limits.toml"]);
+}
+
 #[test]
 fn a_candidate_whose_run_fails_scores_as_failed_and_the_fit_goes_on() {
     let dir = tempfile::tempdir().unwrap();
