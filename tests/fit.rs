@@ -320,8 +320,9 @@ fn the_shipped_tune_files_load() {
             loaded.push(name);
         }
     }
-    loaded.sort();
-    assert_eq!(loaded, ["tune-gains.toml", "tune-paper-limits.toml"]);
+    for shipped in ["tune-gains.toml", "tune-paper-limits.toml"] {
+        assert!(loaded.iter().any(|n| n == shipped), "{shipped} not found among {loaded:?}");
+    }
 }
 
 #[test]
