@@ -34,6 +34,10 @@ pub struct ChartArgs {
     /// Convergence: the physics backend (`mujoco` or `rapier`) [default: the scenario's].
     #[arg(long)]
     backend: Option<Backend>,
+    /// Convergence: halve the timestep down to this one at least \[s\], for a finer reference pair
+    /// [default: 0.000625, the "down to at least 0.625 ms"; at most that, at least 1e-5].
+    #[arg(long, value_name = "SECONDS")]
+    finest_step: Option<f64>,
     /// Convergence: override a scenario value in every run: `--set key.path=value` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<crate::scenario::Override>,
@@ -89,14 +93,24 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
 /// `tendril chart convergence`: every case (object × feedback × seed) over the refinements, the
 /// criteria judged and printed. Returns the files written and whether every criterion holds.
 fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<PathBuf>, bool)> {
-    use study::convergence::{CRITERIA, Case, Plan, run};
+    use study::convergence::{CRITERIA, Case, FINEST_TIMESTEP_S, Plan, run};
     let mut extra = a.set.clone();
     extra.extend(a.backend.map(crate::scenario::Override::backend));
     // The refinements start from the first scenario's own timestep and links (after --set).
     let scenarios = objects_or(&a.scenario);
     let base: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&scenarios[0], &extra)?;
     let (dt, links) = (base.physics.timestep_s, base.finger.segments);
-    let plan = if a.quick { Plan::quick(dt, links) } else { Plan::full(dt, links) };
+    let finest = a.finest_step.unwrap_or(FINEST_TIMESTEP_S);
+    // 1e-5 s: the scenario's own lower bound on `physics.timestep_s`.
+    if !(1e-5..=FINEST_TIMESTEP_S).contains(&finest) {
+        anyhow::bail!(
+            "--finest-step: must be between 0.00001 and {FINEST_TIMESTEP_S} s (the issue's coarsest reference), got {finest}"
+        );
+    }
+    if a.quick && a.finest_step.is_some() {
+        anyhow::bail!("--finest-step: the --quick plan has no finest setting (default, step/2 and links x2 only)");
+    }
+    let plan = if a.quick { Plan::quick(dt, links) } else { Plan::full(dt, links, finest) };
     let seeds = if a.seeds.is_empty() { vec![1, 2, 3] } else { a.seeds.clone() };
     let cases: Vec<Case> = scenarios
         .into_iter()

@@ -14,8 +14,9 @@ use crate::run::metrics::despiked;
 use crate::run::trace::TraceRow;
 use std::path::{Path, PathBuf};
 
-/// The study halves the timestep down to this one at least \[s\]: the issue's "down to at least
-/// 0.625 ms" (and always at least twice, step/2 and step/4).
+/// The study halves the timestep down to this one at least \[s\] unless asked for a finer one
+/// (`tendril chart convergence --finest-step`): the issue's "down to at least 0.625 ms" (and always
+/// at least twice, step/2 and step/4).
 pub const FINEST_TIMESTEP_S: f64 = 0.000625;
 
 /// What "converged" means here: two settings give the same answers within these tolerances.
@@ -59,14 +60,15 @@ pub struct Plan {
 
 impl Plan {
     /// The full study from the default timestep and links: the timestep halved at least twice and
-    /// down to [`FINEST_TIMESTEP_S`] or below, the links ×2 and ×4, the finest of both, and its two
-    /// neighbours (one refinement coarser in time, one in links) for the reference pair.
-    pub fn full(timestep_s: f64, segments: u32) -> Plan {
+    /// down to `finest_timestep_s` or below ([`FINEST_TIMESTEP_S`] unless a finer reference is
+    /// wanted), the links ×2 and ×4, the finest of both, and its two neighbours (one refinement
+    /// coarser in time, one in links) for the reference pair.
+    pub fn full(timestep_s: f64, segments: u32, finest_timestep_s: f64) -> Plan {
         let s = |label: String, timestep_s: f64, segments: u32| Setting { label, timestep_s, segments };
         let mut settings = vec![s("default".into(), timestep_s, segments)];
         let mut dt = timestep_s;
         let mut k = 1;
-        while k <= 2 || dt > FINEST_TIMESTEP_S * 1.0001 {
+        while k <= 2 || dt > finest_timestep_s * 1.0001 {
             dt /= 2.0;
             settings.push(s(format!("step/{}", 1 << k), dt, segments));
             k += 1;
@@ -379,7 +381,7 @@ mod tests {
 
     #[test]
     fn the_full_plan_halves_the_step_to_the_finest_and_judges_the_issue_pairs() {
-        let plan = Plan::full(0.005, 8);
+        let plan = Plan::full(0.005, 8, FINEST_TIMESTEP_S);
         let labels: Vec<&str> = plan.settings.iter().map(|s| s.label.as_str()).collect();
         assert_eq!(
             labels,
@@ -413,10 +415,17 @@ mod tests {
             ]
         );
         // A default one halving from 0.625 ms is still halved twice: step/2 and step/4 are always judged.
-        let fine = Plan::full(0.00125, 64);
+        let fine = Plan::full(0.00125, 64, FINEST_TIMESTEP_S);
         let steps: Vec<(&str, f64)> = fine.settings.iter().take(4).map(|s| (s.label.as_str(), s.timestep_s)).collect();
         assert_eq!(steps, [("default", 0.00125), ("step/2", 0.000625), ("step/4", 0.0003125), ("links x2", 0.00125)]);
         assert_eq!(fine.settings.last().unwrap().segments, 256);
+        // A finer reference on request: the default's step halved down to it, the pairs the same.
+        let finer = Plan::full(0.0025, 8, 0.00015625);
+        let steps: Vec<f64> = finer.settings.iter().filter(|s| s.segments == 8).map(|s| s.timestep_s).collect();
+        assert_eq!(steps, [0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625]);
+        let finest = finer.settings.last().unwrap();
+        assert_eq!((finest.timestep_s, finest.segments), (0.00015625, 32));
+        assert_eq!(finer.comparisons.len(), plan.comparisons.len());
     }
 
     #[test]
