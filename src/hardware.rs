@@ -8,10 +8,19 @@
 
 use crate::control::task::Phase;
 use crate::signals::Wavelengths;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Number of UR5e joints.
 pub const ARM_JOINTS: usize = 6;
+
+/// How many control ticks in a row the loop may run without a fresh, valid sensor sample, holding
+/// the last estimate: 10, 0.1 s at the default 100 Hz, a twentieth of the closed loop's time
+/// constant (≈ 2 s). Holding the estimate that long cannot move the grip far (at the PID's 90 °/s
+/// limit the twine turns 9°, ≈ 0.2 N on the finger's force gain), while a sensor that stays bad
+/// or silent longer leaves the loop blind and must stop the run. The runner counts invalid samples
+/// against it; a real cell's watchdog counts the ticks a device stream misses
+/// (`crate::cell::real::Watchdog`).
+pub const BLIND_TICKS: u32 = 10;
 
 /// The lifecycle states of a cell (ros2_control's managed-node states, minus error handling).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -73,6 +82,47 @@ pub struct GroundTruth {
     pub object_in_hand_m: [f64; 3],
 }
 
+/// Percentiles of a timing over a run \[ms\].
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Spread {
+    /// Median \[ms\].
+    pub p50_ms: f64,
+    /// 99th percentile \[ms\].
+    pub p99_ms: f64,
+    /// Largest \[ms\].
+    pub max_ms: f64,
+}
+
+impl Spread {
+    /// The spread of `values_s` \[s\] (all zero when empty).
+    pub fn of(values_s: &[f64]) -> Spread {
+        if values_s.is_empty() {
+            return Spread::default();
+        }
+        let mut v = values_s.to_vec();
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize] * 1e3;
+        Spread { p50_ms: at(0.5), p99_ms: at(0.99), max_ms: at(1.0) }
+    }
+}
+
+/// How a real cell's device streams kept up over a run: how old each stream's latest sample was
+/// when a tick read it, against the watchdog's limit, and how late the ticks were. What a user
+/// reads to see how close a run on an ordinary PC came to a watchdog stop.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct DeviceTiming {
+    /// Age of the interrogator's latest peak sample at each tick.
+    pub sensor_age: Spread,
+    /// Age of the arm's latest RTDE sample at each tick.
+    pub arm_age: Spread,
+    /// Age of the motors' latest positions at each tick.
+    pub motor_age: Spread,
+    /// How late each tick's read came after its deadline.
+    pub tick_late: Spread,
+    /// The watchdog's limits: sensor, arm, motors \[ms\].
+    pub watchdog_ms: [f64; 3],
+}
+
 /// Why a cell operation failed.
 #[derive(Debug, thiserror::Error)]
 pub enum CellError {
@@ -131,6 +181,10 @@ pub trait Cell {
     fn write(&mut self, command: &CellCommand) -> Result<(), CellError>;
     /// Lets time pass until cell time `time_s`: a simulation steps, a real cell sleeps.
     fn wait_until(&mut self, time_s: f64) -> Result<(), CellError>;
+    /// How the device streams kept up so far, when the cell has devices (a real cell).
+    fn device_timing(&self) -> Option<DeviceTiming> {
+        None
+    }
     /// Ground truth, when the cell is a simulation.
     fn ground_truth(&self) -> Option<GroundTruth> {
         None
@@ -141,8 +195,8 @@ pub trait Cell {
     fn phase_started(&mut self, _phase: Phase, _time_s: f64) {}
     /// Whether the wavelengths of the last [`Cell::read`] are a new interrogator sample (`false`
     /// when the interrogator delivered nothing since the read before, as in the twin's
-    /// `[disturbance.dropout]`). A real cell reports every read as new: its watchdog stops the run
-    /// on a stale stream instead.
+    /// `[disturbance.dropout]`, or a real cell's stream late by a tick). A stream silent for long
+    /// is the real cell's watchdog's to stop.
     fn sample_is_new(&self) -> bool {
         true
     }

@@ -1,7 +1,7 @@
 //! The controllers beyond the paper's PID (`feedforward`, `slip_margin`) run on the real path as
 //! they do on the twin: the short grasp-hold-lift against the virtual devices (`tendril serve`'s
 //! devices, in-process, in real time), compared phase by phase with the same scenario on the
-//! simulated path within `common::phases`' tolerances.
+//! simulated path within `tendril::run::compare`'s tolerances, with the default watchdogs.
 
 use tendril::cell::real::RealCellConfig;
 use tendril::cell::real::serve::{ServeConfig, start};
@@ -10,7 +10,7 @@ use tendril::run::real::run_on_real;
 use tendril::run::runner::Outcome;
 
 mod common;
-use common::{loose_watchdog, one_at_a_time, phases, short_lift};
+use common::{one_at_a_time, phases, short_lift};
 
 #[test]
 fn feedforward_and_slip_margin_run_on_the_real_path_as_on_the_twin() {
@@ -22,8 +22,7 @@ fn feedforward_and_slip_margin_run_on_the_real_path_as_on_the_twin() {
         assert_eq!(sim.outcome, Outcome::Held, "{controller} on the twin: {:?}", sim.error);
 
         let serve = start(&scenario, &ServeConfig::loopback().with_port_base(port_base)).unwrap();
-        let mut config = RealCellConfig::for_virtual_devices(&serve);
-        loose_watchdog(&mut config);
+        let config = RealCellConfig::for_virtual_devices(&serve);
         let (summary, real) = run_on_real(&scenario, config, None).unwrap();
         serve.stop().unwrap();
 

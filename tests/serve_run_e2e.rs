@@ -3,8 +3,8 @@
 //! (RTDE, URScript, HYPERION on loopback, the Dynamixel bus on the pty `serve` prints), and the
 //! simulated path `tendril run scenarios/short-lift.toml`. Both runs' `summary.json` must give
 //! the same outcome, and their `trace.csv` per-phase force percentiles and durations must agree
-//! within the tolerances of `common::phases` (which also says why the grasp's is looser). About
-//! 16 s of wall time.
+//! within the tolerances of `tendril::run::compare` (which also says why the grasp's is looser),
+//! with the default watchdogs, as a user runs it. About 16 s of wall time.
 //!
 //! Where the system allows it (root or CAP_SYS_NICE), both processes run their time-critical
 //! threads under SCHED_FIFO, as the docs advise for a real cell; elsewhere the test runs at normal
@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 use common::cli::tendril_command;
-use common::{LOOSE_WATCHDOG_S, SHORT_LIFT, one_at_a_time, phases};
+use common::{SHORT_LIFT, one_at_a_time, phases};
 
 /// A running `tendril serve`, killed when dropped (also when the test fails).
 struct Server {
@@ -159,14 +159,10 @@ fn tendril_run_real_against_tendril_serve_matches_the_simulated_run() {
 
     let (serve_rt, run_rt) = realtime_args();
     let (server, base, pty) = serve(&serve_rt);
-    let watchdog_ms = (LOOSE_WATCHDOG_S * 1e3).to_string();
-    let sensor_samples = (LOOSE_WATCHDOG_S * 1e3).to_string(); // at the interrogator's 1 kHz
     let real = run_with_limit(
         tendril_command()
             .args(["run", SHORT_LIFT, "--hardware", "real", "--port-base", &base.to_string(), "--dxl"])
             .arg(&pty)
-            .args(["--sensor-stale-samples", &sensor_samples, "--arm-stale-ms", &watchdog_ms])
-            .args(["--dxl-timeout-ms", &watchdog_ms])
             .args(&run_rt)
             .arg("--out")
             .arg(&real_dir),
@@ -209,12 +205,9 @@ fn sigterm_on_the_real_path_stops_safely_and_keeps_both_files() {
     let _turn = one_at_a_time();
     let dir = tempfile::tempdir().unwrap();
     let (server, base, pty) = serve(&[]);
-    let watchdog_ms = (LOOSE_WATCHDOG_S * 1e3).to_string();
     let child = tendril_command()
         .args(["run", SHORT_LIFT, "--hardware", "real", "--port-base", &base.to_string(), "--dxl"])
         .arg(&pty)
-        .args(["--sensor-stale-samples", &watchdog_ms, "--arm-stale-ms", &watchdog_ms])
-        .args(["--dxl-timeout-ms", &watchdog_ms])
         .arg("--out")
         .arg(dir.path())
         .stdout(Stdio::piped())

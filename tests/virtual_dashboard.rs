@@ -12,7 +12,7 @@ use tendril::cell::real::{RealCell, RealCellConfig};
 use tendril::hardware::Cell;
 
 mod common;
-use common::{loose_watchdog, one_at_a_time, short_lift};
+use common::{one_at_a_time, short_lift};
 
 /// A line-oriented dashboard client on a plain socket.
 struct Dashboard {
@@ -125,9 +125,7 @@ fn the_dashboard_answers_as_the_controller_does_and_30003_takes_programs() {
 /// The real path's configure against the virtual UR in `set`'s state: the error, if any.
 fn configure_error(serve: &ServeHandle, set: impl FnOnce(&mut tendril::cell::real::serve::DeviceState)) -> String {
     set(&mut serve.state.lock().unwrap());
-    let mut config = RealCellConfig::for_virtual_devices(serve);
-    loose_watchdog(&mut config);
-    let mut cell = RealCell::new(config);
+    let mut cell = RealCell::new(RealCellConfig::for_virtual_devices(serve));
     let result = cell.configure();
     let _ = cell.deactivate();
     drop(cell);

@@ -22,6 +22,8 @@ struct Rtde {
     buf: Vec<u8>,
     events: VecDeque<ClientEvent>,
     input_recipe: u8,
+    /// The client's clock: targets are stamped with their time on it.
+    clock: Instant,
 }
 
 impl Rtde {
@@ -29,8 +31,14 @@ impl Rtde {
     fn start(addr: SocketAddr, outputs: &[&str], inputs: &[&str]) -> Rtde {
         let socket = TcpStream::connect(addr).unwrap();
         socket.set_nodelay(true).unwrap();
-        let mut c =
-            Rtde { socket, session: ClientSession::new(), buf: Vec::new(), events: VecDeque::new(), input_recipe: 0 };
+        let mut c = Rtde {
+            socket,
+            session: ClientSession::new(),
+            buf: Vec::new(),
+            events: VecDeque::new(),
+            input_recipe: 0,
+            clock: Instant::now(),
+        };
         let p = c.session.request_protocol_version();
         assert_eq!(c.request(p), ClientEvent::ProtocolVersion { accepted: true });
         let p = c.session.setup_outputs(500.0, outputs).unwrap();
@@ -86,9 +94,11 @@ impl Rtde {
         }
     }
 
-    /// The six targets and the enable flag of the follow program, in one package.
+    /// The six targets, their time on the client's clock (now) and the enable flag of the follow
+    /// program, in one package.
     fn targets(&mut self, q: [f64; 6], enable: bool) {
         let mut values: Vec<RtdeValue> = q.iter().map(|&v| RtdeValue::Double(v)).collect();
+        values.push(RtdeValue::Double(self.clock.elapsed().as_secs_f64()));
         values.push(RtdeValue::Int32(i32::from(enable)));
         let p = self.session.input_data(self.input_recipe, &values).unwrap();
         self.send(p);

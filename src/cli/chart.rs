@@ -10,8 +10,10 @@ use std::process::ExitCode;
 #[derive(Debug, clap::Args)]
 pub struct ChartArgs {
     /// Which study: `convergence` (exits 1 when a convergence criterion breaks), `speed-accuracy`,
-    /// `stability`, `gain-map` or `controllers` (each force controller under disturbances).
-    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers"])]
+    /// `stability`, `gain-map`, `controllers` (each force controller under disturbances) or
+    /// `jitter` (the real path against the virtual devices under injected timing jitter, in real
+    /// time: about 14 s a run).
+    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter"])]
     study: String,
     /// Scenario to study [default: convergence, gain-map and controllers the three objects; speed-accuracy the crimper (its fine reference drops it too, so
     /// drop times compare), stability the hammer (the heaviest load)].
@@ -27,8 +29,8 @@ pub struct ChartArgs {
     /// side by side do not slow each other's figures (beyond shared caches).
     #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
-    /// Convergence and controllers: the seeds of every case [default: convergence 1,2,3;
-    /// controllers 1-10, with --quick 1,2].
+    /// Convergence, controllers and jitter: the seeds of every case [default: convergence 1,2,3;
+    /// controllers 1-10, with --quick 1,2; jitter 1,2, with --quick 1].
     #[arg(long, value_delimiter = ',')]
     seeds: Vec<u64>,
     /// Convergence: the physics backend (`mujoco` or `rapier`) [default: the scenario's].
@@ -82,6 +84,10 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             study::gain_map::run(&scenarios, kp, ki, &out, a.threads)?
         }
         "controllers" => controllers(&a, &out)?,
+        "jitter" => {
+            let seeds = if a.seeds.is_empty() { if a.quick { vec![1] } else { vec![1, 2] } } else { a.seeds.clone() };
+            study::jitter::run(&first("scenarios/short-lift.toml"), &study::jitter::cases(a.quick), &seeds, &out)?
+        }
         other => anyhow::bail!("unknown study `{other}`"),
     };
     for f in files {

@@ -25,15 +25,18 @@ pub struct DeviceArgs {
     /// HYPERION commands N+2, peaks N+3, UR dashboard N+4.
     #[arg(long, value_parser = port_base)]
     port_base: Option<u16>,
-    /// Sensor watchdog: stop when the latest peak sample is this many interrogator periods old.
-    #[arg(long, default_value_t = 5.0)]
-    sensor_stale_samples: f64,
-    /// Arm watchdog: stop when the latest RTDE sample is this old [ms] (5 periods at 500 Hz).
-    #[arg(long, default_value_t = 10.0)]
-    arm_stale_ms: f64,
-    /// Motor watchdog: stop when a motor has not answered within this time [ms].
-    #[arg(long, default_value_t = 50.0)]
-    dxl_timeout_ms: f64,
+    /// Sensor watchdog: stop when the latest peak sample is this old [ms] [default: 10 control
+    /// ticks plus one interrogator period, 101 ms at 100 Hz and 1 kHz; docs/hardware.md, "Watchdogs"].
+    #[arg(long)]
+    sensor_stale_ms: Option<f64>,
+    /// Arm watchdog: stop when the latest RTDE sample is this old [ms] [default: 10 control ticks
+    /// plus one RTDE period, 102 ms at 100 Hz].
+    #[arg(long)]
+    arm_stale_ms: Option<f64>,
+    /// Motor watchdog: stop when the motors' positions are this old, or a motor has not answered
+    /// within this time [ms] [default: 10 control ticks, 100.5 ms at 100 Hz].
+    #[arg(long)]
+    motor_stale_ms: Option<f64>,
     #[command(flatten)]
     realtime: super::realtime::RealtimeArgs,
 }
@@ -55,24 +58,26 @@ impl DeviceArgs {
     /// The cell configuration; the interrogator period and `[hardware]` come from the scenario.
     pub fn config(&self, scenario: &PickPlaceScenario) -> anyhow::Result<RealCellConfig> {
         let dxl = self.dxl.as_deref().ok_or_else(|| anyhow::anyhow!("--hardware real needs --dxl PORT"))?;
-        anyhow::ensure!(
-            self.sensor_stale_samples.is_finite() && self.sensor_stale_samples >= 1.0,
-            "--sensor-stale-samples must be at least 1"
-        );
-        anyhow::ensure!(
-            self.arm_stale_ms.is_finite() && self.arm_stale_ms >= 2.0,
-            "--arm-stale-ms must be at least 2 (one RTDE period)"
-        );
-        anyhow::ensure!(
-            self.dxl_timeout_ms.is_finite() && (1.0..=10_000.0).contains(&self.dxl_timeout_ms),
-            "--dxl-timeout-ms must be 1-10000"
-        );
         let mut c = RealCellConfig::new(&self.ur, dxl, &self.interrogator);
-        c.dxl_reply_timeout = std::time::Duration::from_secs_f64(self.dxl_timeout_ms * 1e-3);
         c.hardware = scenario.hardware;
         c.sensor_period_s = 1.0 / scenario.interrogator.sample_rate_hz;
-        c.sensor_stale_samples = self.sensor_stale_samples;
-        c.arm_stale_s = self.arm_stale_ms * 1e-3;
+        let mut c = c.with_control_rate(scenario.control_rate_hz);
+        // The limits: at least one period of their stream, at most 10 s (a UR5e's own program
+        // watchdog stops the arm after 0.5 s without our inputs).
+        let w = &mut c.watchdog;
+        for (flag, given, limit, least_ms) in [
+            ("--sensor-stale-ms", self.sensor_stale_ms, &mut w.sensor_stale_s, c.sensor_period_s * 1e3),
+            ("--arm-stale-ms", self.arm_stale_ms, &mut w.arm_stale_s, 1e3 / crate::cell::real::ur::OUTPUT_RATE_HZ),
+            ("--motor-stale-ms", self.motor_stale_ms, &mut w.motor_stale_s, 1.0),
+        ] {
+            if let Some(ms) = given {
+                anyhow::ensure!(
+                    ms.is_finite() && (least_ms..=10_000.0).contains(&ms),
+                    "{flag} must be {least_ms}-10000 (one period of its stream to 10 s), got {ms}"
+                );
+                *limit = ms * 1e-3;
+            }
+        }
         Ok(match self.port_base {
             Some(base) => c.with_port_base(base),
             None => c,

@@ -24,11 +24,11 @@ pub struct LatencyArgs {
     /// Ports of the virtual devices (N .. N+5 on 127.0.0.1).
     #[arg(long, default_value_t = 39400, value_parser = super::devices::port_base)]
     port_base: u16,
-    /// Sensor watchdog [interrogator periods], also the arm watchdog and the motors' reply timeout
-    /// (500: 0.5 s); far looser than a run's, so that the thread not being run for a while (tens
-    /// of ms on a shared virtual machine) shows up in the figures instead of ending the measurement.
+    /// Every watchdog limit [ms] (the sensor's, the arm's and the motors'); 500 ms by default, far
+    /// looser than a run's, so that the thread not being run for a while (tens of ms on a shared
+    /// virtual machine) shows up in the figures instead of ending the measurement.
     #[arg(long, default_value_t = 500.0)]
-    sensor_stale_samples: f64,
+    stale_ms: f64,
     #[command(flatten)]
     realtime: super::realtime::RealtimeArgs,
     /// Run the virtual devices' threads (twin, bus, network) on this CPU only; with `--cpu` for
@@ -53,8 +53,9 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
         a.rate_hz
     );
     anyhow::ensure!(
-        a.sensor_stale_samples.is_finite() && a.sensor_stale_samples >= 1.0,
-        "--sensor-stale-samples must be at least 1"
+        a.stale_ms.is_finite() && (2.0..=10_000.0).contains(&a.stale_ms),
+        "--stale-ms must be 2-10000 (one RTDE period to 10 s), got {}",
+        a.stale_ms
     );
     let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &[])?;
     let control = a.realtime.options()?;
@@ -80,9 +81,7 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     let serve = start(&scenario, &serve_config)?;
     let mut config = RealCellConfig::for_virtual_devices(&serve);
     config.sensor_period_s = 1.0 / scenario.interrogator.sample_rate_hz;
-    config.sensor_stale_samples = a.sensor_stale_samples;
-    config.arm_stale_s = a.sensor_stale_samples * config.sensor_period_s;
-    config.dxl_reply_timeout = std::time::Duration::from_secs_f64(config.arm_stale_s);
+    config.watchdog = crate::cell::real::Watchdog::uniform(a.stale_ms * 1e-3);
     // After the devices started, so that they do not inherit the control thread's CPU.
     control.apply_to_current_thread()?;
     let mut cell = RealCell::new(config);

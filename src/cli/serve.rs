@@ -1,7 +1,8 @@
 //! `tendril serve`: the twin behind the real devices' protocols.
 
 use super::emit;
-use crate::cell::real::serve::{ProgramState, ServeConfig, start};
+use crate::cell::real::serve::jitter::Link;
+use crate::cell::real::serve::{Jitter, JitterProfile, ProgramState, ServeConfig, start};
 use crate::run::scenario::PickPlaceScenario;
 use crate::scenario::Override;
 use std::net::IpAddr;
@@ -32,6 +33,17 @@ pub struct ServeArgs {
     /// Override a scenario value: `--set key.path=value` (repeatable).
     #[arg(long = "set")]
     set: Vec<Override>,
+    /// Timing faults the devices inject into their links, to try a client against an ordinary PC
+    /// or a Wi-Fi link: `loopback`, `busy-pc` or `wifi` (each stated in docs/hardware.md, "Timing
+    /// on an ordinary PC") [default: none].
+    #[arg(long, value_enum, default_value = "none")]
+    jitter: JitterProfile,
+    /// Seed of the injected jitter's delays.
+    #[arg(long, default_value_t = 1)]
+    jitter_seed: u64,
+    /// Inject the jitter into this link only (`rtde-out`, `rtde-in`, `peaks`, `bus`) [default: all].
+    #[arg(long, value_enum)]
+    jitter_link: Option<Link>,
     #[command(flatten)]
     realtime: super::realtime::RealtimeArgs,
 }
@@ -45,6 +57,7 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     if let Some(base) = a.port_base {
         config = config.with_port_base(base);
     }
+    config.jitter = Jitter::profile(a.jitter, a.jitter_seed).map(|j| Jitter { only: a.jitter_link, ..j });
     let handle = start(&scenario, &config)?;
     let [rtde, script, command, stream] = handle.addrs;
     let (dashboard, realtime_script) = (handle.ur_addrs.dashboard, handle.ur_addrs.realtime_script);
@@ -58,6 +71,13 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
         h.twine_id,
         h.dxl_baud
     ));
+    if let Some(j) = config.jitter {
+        let link = j.only.map_or("every link".to_string(), |l| format!("{l:?}"));
+        emit(&format!(
+            "  jitter    {:?} on {link}, seed {} (docs/hardware.md, \"Injected jitter\")\n",
+            a.jitter, j.seed
+        ));
+    }
     // Ctrl-C, SIGTERM and SIGHUP alike: the devices are shut down and the status reported.
     crate::interrupt::install()?;
     let started = std::time::Instant::now();

@@ -1,6 +1,6 @@
 //! Charts (PNG and SVG) from files on disk: a run's trace, a sweep's heatmaps, the
 //! speed-against-accuracy scatter, the convergence panels, the stability dot matrix, the gain maps and
-//! the controller study's bars.
+//! the controller study's bars, the real path under jitter.
 //!
 //! Every chart is drawn once per backend by a [`Chart`] so the PNG and the SVG agree. Text uses
 //! DejaVu Sans embedded in the binary, so PNGs render on a machine without system fonts.
@@ -12,6 +12,7 @@ pub mod fit;
 pub mod gain_map;
 pub mod grid;
 pub mod input;
+pub mod jitter;
 pub mod speed_accuracy;
 pub mod stability;
 pub mod style;
@@ -53,8 +54,8 @@ pub enum PlotError {
     },
     /// The path holds none of the files `tendril plot` knows.
     #[error(
-        "{0}: no trace.csv, results.csv, speed_accuracy.csv, convergence.csv, stability.csv, gain_map.csv or \
-         controllers.csv here"
+        "{0}: no trace.csv, results.csv, speed_accuracy.csv, convergence.csv, stability.csv, gain_map.csv, \
+         controllers.csv or jitter.csv here"
     )]
     NothingToPlot(String),
     /// Drawing failed (plotters backend error).
@@ -110,7 +111,7 @@ pub fn save<C: Chart>(chart: &C, out_dir: &Path, stem: &str) -> Result<Vec<PathB
 ///
 /// PATH is a run directory (`trace.csv`, optional `summary.json`), a sweep directory
 /// (`results.csv`), a directory holding any of `speed_accuracy.csv`, `stability.csv`,
-/// `gain_map.csv`, `controllers.csv`, or one of those files. Charts go to `out` (default: the directory of the input).
+/// `gain_map.csv`, `controllers.csv`, `jitter.csv`, or one of those files. Charts go to `out` (default: the directory of the input).
 pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotError> {
     let (dir, only) = if path.is_file() {
         (
@@ -145,6 +146,9 @@ pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotEr
     }
     if wanted("gain_map.csv") {
         written.extend(gain_map::render(&gain_map::read(&dir.join("gain_map.csv"))?, &out_dir)?);
+    }
+    if wanted("jitter.csv") {
+        written.extend(jitter::render(&jitter::read(&dir.join("jitter.csv"))?, &out_dir)?);
     }
     if wanted("controllers.csv") {
         written.extend(controllers::render(&controllers::read(&dir.join("controllers.csv"))?, &out_dir)?);

@@ -9,8 +9,10 @@
 //! - [`output`]: the default output folder derived from a scenario's name.
 //! - [`metrics`]: rise time, overshoot, fluctuation, estimate error.
 //! - [`summary`]: the `summary.json` record.
+//! - [`compare`]: two runs of a scenario, phase by phase (the real path against the twin).
 
 pub mod clock;
+pub mod compare;
 pub mod drop_watch;
 pub mod execute;
 pub mod metrics;

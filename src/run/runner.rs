@@ -87,15 +87,15 @@ pub struct RunReport {
     pub dropped_samples: u64,
     /// Every tick, as written to the trace.
     pub rows: Vec<TraceRow>,
+    /// How the device streams kept up (a real cell).
+    pub device_timing: Option<crate::hardware::DeviceTiming>,
 }
 
 /// Consecutive invalid sensor samples (no estimate: non-finite, or below the calibration curve)
-/// that end a run. A lone bad sample is skipped and the last valid estimate held; 10 ticks are
-/// 0.1 s at the default 100 Hz control rate, a twentieth of the closed loop's time constant
-/// (≈ 2 s): holding the estimate that long cannot move the grip far (at the PID's 90 °/s limit the
-/// twine turns 9°, ≈ 0.2 N on the finger's force gain), while a sensor that stays bad longer —
-/// a broken fibre, an interrogator out of lock — leaves the loop blind and must stop the run.
-pub const MAX_CONSECUTIVE_INVALID_SAMPLES: u32 = 10;
+/// that end a run: [`crate::hardware::BLIND_TICKS`]. A lone bad sample is skipped and the last
+/// valid estimate held; a sensor that stays bad longer (a broken fibre, an interrogator out of
+/// lock) leaves the loop blind and must stop the run.
+pub const MAX_CONSECUTIVE_INVALID_SAMPLES: u32 = crate::hardware::BLIND_TICKS;
 
 /// Runs the task on `cell`, writing each tick to `trace` when given. The cell is configured,
 /// activated and, whatever happens, deactivated. Cell errors end the run with
@@ -241,6 +241,7 @@ pub fn run_task_observed(
     };
     let result = run();
     let stop = cell.deactivate();
+    let device_timing = cell.device_timing();
     if let Some(w) = trace {
         // A failed flush is kept in the writer and reported by the caller with the other write errors.
         let _ = w.flush();
@@ -269,6 +270,7 @@ pub fn run_task_observed(
         invalid_samples: invalid.total,
         dropped_samples,
         rows,
+        device_timing,
     }
 }
 

@@ -103,6 +103,10 @@ pub struct RunSummary {
     /// estimate was held. Not invalid samples: they do not count towards the consecutive limit.
     #[serde(default)]
     pub dropped_samples: u64,
+    /// On a real cell: how old each device stream's samples were when the ticks read them, and
+    /// how late the ticks were, against the watchdog's limits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device_timing: Option<crate::hardware::DeviceTiming>,
     /// MuJoCo's warnings during the run (see [`crate::mujoco_log`]), at most
     /// [`crate::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
     #[serde(default)]
@@ -155,6 +159,7 @@ impl RunSummary {
             error: report.error.clone(),
             invalid_samples: report.invalid_samples,
             dropped_samples: report.dropped_samples,
+            device_timing: report.device_timing,
             warnings: Vec::new(),
         }
     }
@@ -197,6 +202,14 @@ pub fn render_text(s: &RunSummary) -> String {
     out += "\n";
     if s.dropped_samples > 0 {
         out += &format!("  dropped samples    {} ticks without a new sample (estimate held)\n", s.dropped_samples);
+    }
+    if let Some(t) = &s.device_timing {
+        let [sensor, arm, motors] = t.watchdog_ms;
+        out += &format!(
+            "  device streams     oldest sample at a tick: sensor {:.1} ms, arm {:.1} ms, motors {:.1} ms \
+             (watchdog {sensor:.0} / {arm:.0} / {motors:.0} ms); ticks late p99 {:.2} ms, at most {:.2} ms\n",
+            t.sensor_age.max_ms, t.arm_age.max_ms, t.motor_age.max_ms, t.tick_late.p99_ms, t.tick_late.max_ms
+        );
     }
     if s.invalid_samples > 0 {
         out += &format!("  invalid samples    {} skipped (last valid estimate held)\n", s.invalid_samples);

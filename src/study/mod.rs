@@ -9,10 +9,13 @@
 //! - [`gain_map`]: where in (Kp, Ki) the loop oscillates or loses the object, per object.
 //! - [`controllers`]: each force controller × object × disturbance set over seeds: held rate,
 //!   fluctuation, rise, overshoot, peak force.
+//! - [`jitter`]: the real path against the virtual devices under injected timing jitter, against
+//!   the twin (runs in real time, one at a time).
 
 pub mod controllers;
 pub mod convergence;
 pub mod gain_map;
+pub mod jitter;
 pub mod speed_accuracy;
 pub mod stability;
 

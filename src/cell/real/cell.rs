@@ -9,8 +9,7 @@
 //! activating thread's timer slack at 1 ns.
 //!
 //! Safety on our side (the controller's and the servos' own limits still apply):
-//! - watchdog: a sensor sample older than `sensor_stale_samples` interrogator periods, an arm
-//!   sample older than `arm_stale_s`, motor positions older than `dxl_reply_timeout`, the arm
+//! - watchdog ([`Watchdog`]): a sensor, arm or motor sample older than its limit, the arm
 //!   leaving running/normal mode, or the follow program no longer playing (stopped on the
 //!   pendant), fails `read`; the runner then calls [`Cell::deactivate`];
 //! - Ctrl-C (when [`RealCellConfig::handle_ctrl_c`]) fails the next `read` the same way (the CLI
@@ -30,9 +29,12 @@ use super::dxl_link::{GripperLink, LinkStats};
 use super::interrogator::{self, PeakFeed};
 use super::protocol::rtde::state::{ROBOT_MODE_RUNNING, RUNTIME_STATE_PLAYING, SAFETY_MODE_NORMAL};
 use super::serve::ServeHandle;
-use super::ur::{self, UrClient};
+use super::ur::{self, ArmSample, UrClient};
 use super::urscript::FOLLOW_SCRIPT;
-use crate::hardware::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, Lifecycle, require_state};
+use crate::hardware::{
+    ARM_JOINTS, BLIND_TICKS, Cell, CellCommand, CellError, CellState, DeviceTiming, Lifecycle, Spread, require_state,
+};
+use crate::signals::Wavelengths;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -44,6 +46,57 @@ use std::time::{Duration, Instant};
 /// millisecond or more, of which this hides half. Short against the motors' motion: at the
 /// MX-106's 45 rpm no-load speed, 0.14° in 0.5 ms.
 pub const PREFETCH_BEFORE_TICK: Duration = Duration::from_micros(500);
+
+/// The control tick the defaults assume \[s\]: 100 Hz, every shipped scenario's
+/// `control_rate_hz` ([`RealCellConfig::with_control_rate`] sets another).
+pub const DEFAULT_CONTROL_PERIOD_S: f64 = 0.01;
+
+/// How old the latest sample of each device stream may be when a tick reads it before the cell
+/// stops (`read` fails with a watchdog error; the runner then stops the cell safely).
+///
+/// The limits come from what the control needs, not from how fast a device can stream: the loop
+/// may run [`BLIND_TICKS`] ticks on held values (the same budget as for invalid sensor samples),
+/// and a fresh sample is up to one of its stream's periods old when a tick reads it. A stock
+/// (not real-time) Linux PC does not run a process for several milliseconds every few seconds
+/// (7-16 ms seen on loopback, tens of ms on a shared virtual machine), so limits of a few device
+/// periods (once 5 ms for the 1 kHz peak stream, 10 ms for RTDE) stopped most runs on a healthy
+/// cell; a stream that really stops is still caught within the limit plus one tick. docs/hardware.md,
+/// "Watchdogs", gives each limit and the measurements behind them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Watchdog {
+    /// Peak samples (HYPERION stream) older than this stop the cell \[s\].
+    pub sensor_stale_s: f64,
+    /// Arm samples (RTDE output stream) older than this stop the cell \[s\].
+    pub arm_stale_s: f64,
+    /// Motor positions older than this stop the cell \[s\]; also the longest wait for a motor's
+    /// reply on the bus.
+    pub motor_stale_s: f64,
+}
+
+impl Watchdog {
+    /// The limits for a loop ticking every `control_period_s` \[s\] that may miss [`BLIND_TICKS`]
+    /// ticks' samples, with the interrogator sampling every `sensor_period_s` \[s\]: at 100 Hz and
+    /// 1 kHz, 101 ms for the peaks, 102 ms for RTDE (500 Hz), 100.5 ms for the motors (asked
+    /// [`PREFETCH_BEFORE_TICK`] before each tick).
+    pub fn for_control(control_period_s: f64, sensor_period_s: f64) -> Watchdog {
+        let blind_s = f64::from(BLIND_TICKS) * control_period_s;
+        Watchdog {
+            sensor_stale_s: blind_s + sensor_period_s,
+            arm_stale_s: blind_s + 1.0 / ur::OUTPUT_RATE_HZ,
+            motor_stale_s: blind_s + PREFETCH_BEFORE_TICK.as_secs_f64(),
+        }
+    }
+
+    /// Every limit set to `stale_s` \[s\].
+    pub fn uniform(stale_s: f64) -> Watchdog {
+        Watchdog { sensor_stale_s: stale_s, arm_stale_s: stale_s, motor_stale_s: stale_s }
+    }
+
+    /// The motors' reply timeout.
+    pub fn motor_reply_timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.motor_stale_s)
+    }
+}
 
 /// Where the devices are and how strict the watchdog is.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,18 +122,14 @@ pub struct RealCellConfig {
     pub hardware: HardwareConfig,
     /// Interrogator sample period \[s\] (1 kHz on the si255, hardware.md).
     pub sensor_period_s: f64,
-    /// Watchdog: the sensor sample may be this many periods old before the cell stops [-].
-    /// 5: a few lost samples are tolerated, a stalled stream stops the arm within 5 ms at 1 kHz
-    /// plus one control tick.
-    pub sensor_stale_samples: f64,
-    /// Watchdog on the RTDE stream \[s\]: 5 periods at 500 Hz.
-    pub arm_stale_s: f64,
-    /// Longest wait for a motor's reply ([`super::dxl::REPLY_TIMEOUT`], 50 ms), and the watchdog
-    /// on the motors' positions: older than this, the cell stops.
-    pub dxl_reply_timeout: Duration,
-    /// Check the UR5e's preconditions on its dashboard server, then send the follow program to
-    /// the controller, at configure.
+    /// How old each stream's latest sample may be before the cell stops.
+    pub watchdog: Watchdog,
+    /// Check the UR5e's preconditions on its dashboard server, then send [`RealCellConfig::program`]
+    /// to the controller, at configure.
     pub upload_program: bool,
+    /// The URScript program sent at configure: the follow program ([`FOLLOW_SCRIPT`]) unless a
+    /// variant of it is given (it must read the registers [`super::urscript::input_names`] lists).
+    pub program: String,
     /// Turn Ctrl-C into a clean stop (CLI runs; not in tests).
     pub handle_ctrl_c: bool,
 }
@@ -100,10 +149,9 @@ impl RealCellConfig {
             stream_port: 51972,
             hardware: HardwareConfig::default(),
             sensor_period_s: 1e-3,
-            sensor_stale_samples: 5.0,
-            arm_stale_s: 0.01,
-            dxl_reply_timeout: super::dxl::REPLY_TIMEOUT,
+            watchdog: Watchdog::for_control(DEFAULT_CONTROL_PERIOD_S, 1e-3),
             upload_program: true,
+            program: FOLLOW_SCRIPT.to_string(),
             handle_ctrl_c: false,
         }
     }
@@ -118,6 +166,12 @@ impl RealCellConfig {
         c.dashboard_port = serve.ur_addrs.dashboard.port();
         c.hardware = serve.hardware;
         c
+    }
+
+    /// The watchdog for a control loop ticking at `rate_hz` \[Hz\] ([`Watchdog::for_control`]).
+    pub fn with_control_rate(mut self, rate_hz: f64) -> RealCellConfig {
+        self.watchdog = Watchdog::for_control(1.0 / rate_hz, self.sensor_period_s);
+        self
     }
 
     /// Ports `base` (RTDE), `base+1` (URScript), `base+2` (HYPERION commands), `base+3` (peaks),
@@ -144,6 +198,91 @@ struct Devices {
     peak_task: tokio::task::JoinHandle<()>,
 }
 
+/// The devices' latest samples, as a tick reads them.
+struct Latest {
+    arm: ArmSample,
+    arm_age: Duration,
+    wavelengths: Wavelengths,
+    /// Scan serial number of the peak sample.
+    serial: u64,
+    sensor_age: Duration,
+    motors_rad: [f64; 2],
+    motor_age: Duration,
+    tool_load_n: Option<f64>,
+}
+
+impl Devices {
+    /// The streams' latest samples and their ages; an error when a stream has ended or brought
+    /// nothing yet.
+    fn latest(&self) -> Result<Latest, CellError> {
+        let (arm, arm_age) =
+            self.ur.latest().map_err(|e| device("UR5e", e))?.ok_or_else(|| device("UR5e", "no data"))?;
+        let (wavelengths, sensor_at, serial) = {
+            let feed = self.peaks.lock().unwrap_or_else(|p| p.into_inner());
+            if let Some(why) = &feed.closed {
+                return Err(device("HYPERION", why));
+            }
+            feed.latest.ok_or_else(|| device("HYPERION", "no data"))?
+        };
+        let motors = self.gripper.link()?.latest().map_err(|e| device("MX-106", e))?;
+        Ok(Latest {
+            arm,
+            arm_age,
+            wavelengths,
+            serial,
+            sensor_age: sensor_at.elapsed(),
+            motors_rad: motors.rad,
+            motor_age: motors.requested_at.elapsed(),
+            tool_load_n: self.ur.take_tool_load(),
+        })
+    }
+}
+
+impl Watchdog {
+    /// A watchdog error for the first stream whose latest sample is older than its limit.
+    fn check(&self, l: &Latest) -> Result<(), CellError> {
+        let streams = [
+            ("UR5e", "RTDE sample", l.arm_age, self.arm_stale_s),
+            ("HYPERION", "peak sample", l.sensor_age, self.sensor_stale_s),
+            ("MX-106", "motor positions", l.motor_age, self.motor_stale_s),
+        ];
+        for (name, what, age, limit_s) in streams {
+            if age.as_secs_f64() > limit_s {
+                let (age_ms, limit_ms) = (age.as_secs_f64() * 1e3, limit_s * 1e3);
+                return Err(device(name, format!("watchdog: last {what} {age_ms:.1} ms old (limit {limit_ms:.0} ms)")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What [`Cell::device_timing`] is made from: every tick's sample ages and lateness \[s\].
+#[derive(Debug, Default)]
+struct TimingLog {
+    sensor_s: Vec<f64>,
+    arm_s: Vec<f64>,
+    motor_s: Vec<f64>,
+    late_s: Vec<f64>,
+}
+
+impl TimingLog {
+    fn record(&mut self, l: &Latest) {
+        self.sensor_s.push(l.sensor_age.as_secs_f64());
+        self.arm_s.push(l.arm_age.as_secs_f64());
+        self.motor_s.push(l.motor_age.as_secs_f64());
+    }
+
+    fn summary(&self, w: &Watchdog) -> DeviceTiming {
+        DeviceTiming {
+            sensor_age: Spread::of(&self.sensor_s),
+            arm_age: Spread::of(&self.arm_s),
+            motor_age: Spread::of(&self.motor_s),
+            tick_late: Spread::of(&self.late_s),
+            watchdog_ms: [w.sensor_stale_s, w.arm_stale_s, w.motor_stale_s].map(|s| s * 1e3),
+        }
+    }
+}
+
 /// The real gripping cell.
 pub struct RealCell {
     config: RealCellConfig,
@@ -153,6 +292,16 @@ pub struct RealCell {
     started: Instant,
     stop: Arc<AtomicBool>,
     last_arm_q: Option<[f64; ARM_JOINTS]>,
+    /// Cell time of the last `read` \[s\]: the time the next arm target is for.
+    last_read_s: f64,
+    /// Scan serial number of the peak sample the last `read` returned.
+    last_serial: Option<u64>,
+    /// Whether that sample is another scan than the one before ([`Cell::sample_is_new`]).
+    sample_is_new: bool,
+    /// Sample ages and tick lateness, for [`Cell::device_timing`].
+    timing: TimingLog,
+    /// The deadline the last `wait_until` waited for.
+    deadline: Option<Instant>,
     /// Freshness of the motor positions of activations already ended.
     motor_stats: LinkStats,
     /// Serial number and channel count read at configure.
@@ -174,6 +323,11 @@ impl RealCell {
             started: Instant::now(),
             stop: Arc::new(AtomicBool::new(false)),
             last_arm_q: None,
+            last_read_s: 0.0,
+            timing: TimingLog::default(),
+            deadline: None,
+            last_serial: None,
+            sample_is_new: true,
             motor_stats: LinkStats::default(),
             identity: None,
         }
@@ -218,7 +372,7 @@ impl RealCell {
                 }
                 let ur = UrClient::connect(&ur_addr).await?;
                 if c.upload_program {
-                    ur::upload_program(&script_addr, FOLLOW_SCRIPT).await?;
+                    ur::upload_program(&script_addr, &c.program).await?;
                 }
                 let identity = interrogator::identify(&cmd_addr, &c.hardware.fbg).await?;
                 let stream = interrogator::stream(&stream_addr, c.hardware.fbg).await?;
@@ -234,7 +388,7 @@ impl RealCell {
             });
         }
         let h = c.hardware;
-        let gripper = GripperBus::open(&c.dxl_port, h.dxl_baud, h.motor_ids(), c.dxl_reply_timeout)
+        let gripper = GripperBus::open(&c.dxl_port, h.dxl_baud, h.motor_ids(), c.watchdog.motor_reply_timeout())
             .map_err(CellError::Configure)?;
         self.identity = Some(identity);
         self.runtime = Some(runtime);
@@ -305,9 +459,10 @@ impl Cell for RealCell {
         }
         self.lifecycle = Lifecycle::Inactive;
         let q = self.last_arm_q.unwrap_or([0.0; ARM_JOINTS]);
+        let stamp_s = self.last_read_s;
         let (rt, d) = self.parts();
         // Both stops are attempted even if the first fails.
-        let arm = rt.block_on(d.ur.send(q, false)).map_err(|e| device("UR5e", e));
+        let arm = rt.block_on(d.ur.send(q, stamp_s, false)).map_err(|e| device("UR5e", e));
         let (hand, stats);
         (d.gripper, stats, hand) = std::mem::replace(&mut d.gripper, Gripper::Lost).stop_link_and_hold();
         self.motor_stats += stats;
@@ -319,55 +474,36 @@ impl Cell for RealCell {
         if self.stop.load(Ordering::SeqCst) {
             return Err(device("operator", "stop requested (Ctrl-C)"));
         }
-        let time_s = self.started.elapsed().as_secs_f64();
-        let sensor_stale = Duration::from_secs_f64(self.config.sensor_period_s * self.config.sensor_stale_samples);
-        let arm_stale = Duration::from_secs_f64(self.config.arm_stale_s);
-        let upload = self.config.upload_program;
-        let motors_stale = self.config.dxl_reply_timeout;
-        let (_, d) = self.parts();
-        let (arm, age) = d.ur.latest().map_err(|e| device("UR5e", e))?.ok_or_else(|| device("UR5e", "no data"))?;
-        if age > arm_stale {
-            return Err(device("UR5e", format!("watchdog: last RTDE sample {:.1} ms old", age.as_secs_f64() * 1e3)));
+        let now = Instant::now();
+        let time_s = now.duration_since(self.started).as_secs_f64();
+        if let Some(deadline) = self.deadline.take() {
+            self.timing.late_s.push(now.saturating_duration_since(deadline).as_secs_f64());
         }
+        let upload = self.config.upload_program;
+        let watchdog = self.config.watchdog;
+        let (_, d) = self.parts();
+        let latest = d.latest()?;
+        self.timing.record(&latest);
+        let arm = latest.arm;
+        watchdog.check(&latest)?;
         if arm.robot_mode != ROBOT_MODE_RUNNING || arm.safety_mode != SAFETY_MODE_NORMAL {
             return Err(device("UR5e", format!("robot mode {} safety mode {}", arm.robot_mode, arm.safety_mode)));
         }
         if upload && arm.runtime_state != RUNTIME_STATE_PLAYING {
             return Err(device("UR5e", format!("follow program not playing (runtime state {})", arm.runtime_state)));
         }
-        let wavelengths = {
-            let feed = d.peaks.lock().unwrap_or_else(|p| p.into_inner());
-            if let Some(why) = &feed.closed {
-                return Err(device("HYPERION", why));
-            }
-            let (w, at, _) = feed.latest.ok_or_else(|| device("HYPERION", "no data"))?;
-            let age = at.elapsed();
-            if age > sensor_stale {
-                return Err(device(
-                    "HYPERION",
-                    format!("watchdog: last peak sample {:.1} ms old", age.as_secs_f64() * 1e3),
-                ));
-            }
-            w
-        };
-        let motors = d.gripper.link()?.latest().map_err(|e| device("MX-106", e))?;
-        let age = motors.requested_at.elapsed();
-        if age > motors_stale {
-            return Err(device(
-                "MX-106",
-                format!("watchdog: last motor positions {:.1} ms old", age.as_secs_f64() * 1e3),
-            ));
-        }
-        let [growth, twine] = motors.rad;
-        let tool_load_n = d.ur.take_tool_load();
         self.last_arm_q = Some(arm.q);
+        self.last_read_s = time_s;
+        self.sample_is_new = self.last_serial != Some(latest.serial);
+        self.last_serial = Some(latest.serial);
+        let [growth_motor_rad, twine_motor_rad] = latest.motors_rad;
         Ok(CellState {
             time_s,
             arm_q: arm.q,
-            growth_motor_rad: growth,
-            twine_motor_rad: twine,
-            wavelengths,
-            tool_load_n,
+            growth_motor_rad,
+            twine_motor_rad,
+            wavelengths: latest.wavelengths,
+            tool_load_n: latest.tool_load_n,
         })
     }
 
@@ -376,10 +512,23 @@ impl Cell for RealCell {
         if c.arm_q.iter().chain([&c.growth_motor_rad, &c.twine_motor_rad]).any(|v| !v.is_finite()) {
             return Err(device("command", format!("non-finite target {c:?}")));
         }
+        // The target is the plan's at the last read: stamped with that read's time, the follow
+        // program plays it back at that time, whenever the package arrives.
+        let stamp_s = self.last_read_s;
         let (_, d) = self.parts();
-        d.ur.try_send(c.arm_q, true).map_err(|e| device("UR5e", e))?;
+        d.ur.try_send(c.arm_q, stamp_s, true).map_err(|e| device("UR5e", e))?;
         d.gripper.link()?.set_goal_rad([c.growth_motor_rad, c.twine_motor_rad]);
         Ok(())
+    }
+
+    fn device_timing(&self) -> Option<DeviceTiming> {
+        Some(self.timing.summary(&self.config.watchdog))
+    }
+
+    /// No new scan came since the read before (the stream was late by a tick or more): the runner
+    /// holds the last estimate rather than feeding the estimator the same scan twice.
+    fn sample_is_new(&self) -> bool {
+        self.sample_is_new
     }
 
     fn wait_until(&mut self, time_s: f64) -> Result<(), CellError> {
@@ -396,6 +545,7 @@ impl Cell for RealCell {
         let (_, d) = self.parts();
         d.gripper.link()?.request_present();
         super::realtime::sleep_until(deadline);
+        self.deadline = Some(deadline);
         Ok(())
     }
 }

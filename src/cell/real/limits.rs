@@ -1,16 +1,20 @@
 //! [`LimitedCell`]: a decorator that enforces our own safety limits on any [`Cell`]'s commands
 //! (arci-style: the wrapped cell does not know it is wrapped).
 //!
-//! - Joint speed and acceleration: each arm target may move at most `max_speed·dt` from the last
-//!   one, and its step may change by at most `max_accel·dt²`, `dt` being the cell time between the
-//!   last two reads. The task planner already respects its own limits (paper: 45 °/s, 15 °/s²);
+//! - Joint speed and acceleration: the speed from the last arm target to the next (its step over
+//!   `dt`, the cell time between the last two reads) may be at most `max_speed` and may change by
+//!   at most `max_accel·dt` from the speed before. Speeds, not steps, are compared: on a real cell
+//!   the ticks jitter, and a planned step over a tick 3 ms late is a third longer than the one
+//!   before at the same speed (comparing steps clipped it as an acceleration of a third of the speed
+//!   within a tick). The task planner already respects its own limits (paper: 45 °/s, 15 °/s²);
 //!   these are the backstop against a bad plan or a bug, so a planned trajectory passes unchanged.
 //! - Force ceiling: when the force estimated from the latest wavelengths (eq. 8, tared on the
 //!   first sample after activation: the finger is retracted then) exceeds the ceiling, the twine
 //!   motor may not wind further than its measured position (stop tightening; releasing is allowed).
 
 use crate::control::estimate::{ForceCalibration, ForceEstimator};
-use crate::hardware::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle};
+use crate::control::task::Phase;
+use crate::hardware::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, DeviceTiming, GroundTruth, Lifecycle};
 
 /// The limits a [`LimitedCell`] enforces.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,7 +51,8 @@ pub struct LimitedCell<C: Cell> {
     last_state: Option<CellState>,
     dt_s: f64,
     last_target: Option<[f64; ARM_JOINTS]>,
-    last_step: [f64; ARM_JOINTS],
+    /// The speed of the last target's step \[rad/s\].
+    last_speed: [f64; ARM_JOINTS],
     over_force: bool,
     /// Commands changed by the limits so far (speed/acceleration, force).
     pub interventions: (u64, u64),
@@ -65,7 +70,7 @@ impl<C: Cell> LimitedCell<C> {
             last_state: None,
             dt_s: 0.0,
             last_target: None,
-            last_step: [0.0; ARM_JOINTS],
+            last_speed: [0.0; ARM_JOINTS],
             over_force: false,
             interventions: (0, 0),
         }
@@ -84,17 +89,17 @@ impl<C: Cell> LimitedCell<C> {
             self.last_target = Some(previous);
             return previous;
         }
-        let max_step = self.limits.max_speed_rad_s * self.dt_s;
-        let max_change = self.limits.max_accel_rad_s2 * self.dt_s * self.dt_s;
+        let dt = self.dt_s;
+        let (max_speed, max_change) = (self.limits.max_speed_rad_s, self.limits.max_accel_rad_s2 * dt);
         let mut out = previous;
         let mut clipped = false;
         for j in 0..ARM_JOINTS {
-            let wanted = target[j] - previous[j];
-            let step =
-                wanted.clamp(self.last_step[j] - max_change, self.last_step[j] + max_change).clamp(-max_step, max_step);
-            clipped |= (step - wanted).abs() > 1e-12;
-            out[j] = previous[j] + step;
-            self.last_step[j] = step;
+            let wanted = (target[j] - previous[j]) / dt;
+            let last = self.last_speed[j];
+            let speed = wanted.clamp(last - max_change, last + max_change).clamp(-max_speed, max_speed);
+            clipped |= ((speed - wanted) * dt).abs() > 1e-12;
+            out[j] = previous[j] + speed * dt;
+            self.last_speed[j] = speed;
         }
         if clipped {
             self.interventions.0 += 1;
@@ -118,7 +123,7 @@ impl<C: Cell> Cell for LimitedCell<C> {
         self.tared = false;
         self.last_state = None;
         self.last_target = None;
-        self.last_step = [0.0; ARM_JOINTS];
+        self.last_speed = [0.0; ARM_JOINTS];
         self.inner.activate()
     }
     fn deactivate(&mut self) -> Result<(), CellError> {
@@ -154,6 +159,15 @@ impl<C: Cell> Cell for LimitedCell<C> {
     fn ground_truth(&self) -> Option<GroundTruth> {
         self.inner.ground_truth()
     }
+    fn phase_started(&mut self, phase: Phase, time_s: f64) {
+        self.inner.phase_started(phase, time_s);
+    }
+    fn sample_is_new(&self) -> bool {
+        self.inner.sample_is_new()
+    }
+    fn device_timing(&self) -> Option<DeviceTiming> {
+        self.inner.device_timing()
+    }
 }
 
 #[cfg(test)]
@@ -161,9 +175,12 @@ mod tests {
     use super::*;
     use crate::signals::Wavelengths;
 
-    /// A cell that records commands; time advances 10 ms per read; wavelengths are settable.
+    /// A cell that records commands; time advances by `periods` in turn (10 ms each by default)
+    /// per read; wavelengths are settable.
     struct Recorder {
         t: f64,
+        periods: Vec<f64>,
+        reads: usize,
         w: Wavelengths,
         twine: f64,
         written: Vec<CellCommand>,
@@ -186,7 +203,8 @@ mod tests {
             Ok(())
         }
         fn read(&mut self) -> Result<CellState, CellError> {
-            self.t += 0.01;
+            self.t += self.periods[self.reads % self.periods.len()];
+            self.reads += 1;
             let q = self.written.last().map_or([0.0; ARM_JOINTS], |c| c.arm_q);
             Ok(CellState {
                 time_s: self.t,
@@ -214,7 +232,7 @@ mod tests {
             max_force_n: 2.0,
             calibration: ForceCalibration::default(),
         };
-        LimitedCell::new(Recorder { t: 0.0, w, twine: 1.0, written: Vec::new() }, limits)
+        LimitedCell::new(Recorder { t: 0.0, periods: vec![0.01], reads: 0, w, twine: 1.0, written: Vec::new() }, limits)
     }
 
     fn command(q0: f64, twine: f64) -> CellCommand {
@@ -242,6 +260,21 @@ mod tests {
         }
         assert!((q.last().unwrap() - 1.0).abs() < 1e-9, "the target is reached in the end: {}", q.last().unwrap());
         assert!(c.interventions.0 > 0);
+    }
+
+    #[test]
+    fn a_planned_move_read_on_jittered_ticks_passes_unchanged() {
+        // Ticks 3 ms late then 3 ms early, targets on a move accelerating at 0.5 rad/s² to 0.5 rad/s
+        // (within the limits): each step is the plan's over its own interval, so nothing may be
+        // clipped (comparing steps instead of speeds clipped most of them).
+        let mut c = limited();
+        c.inner.periods = vec![0.01, 0.013, 0.007];
+        c.activate().unwrap();
+        for _ in 0..100 {
+            let t = c.read().unwrap().time_s;
+            c.write(&command(0.25 * t * t, 1.0)).unwrap();
+        }
+        assert_eq!(c.interventions.0, 0, "a planned move was clipped");
     }
 
     #[test]

@@ -23,6 +23,6 @@ pub mod tcp;
 pub mod ur;
 pub mod urscript;
 
-pub use cell::{RealCell, RealCellConfig};
+pub use cell::{RealCell, RealCellConfig, Watchdog};
 pub use config::HardwareConfig;
 pub use limits::{LimitedCell, SafetyLimits};

@@ -159,10 +159,11 @@ impl UrClient {
         Ok(UrClient { session, writer, input_recipe, unsent: Vec::with_capacity(MAX_UNSENT), feed, reader })
     }
 
-    /// Writes the six targets \[rad\] and the enable flag in one data package and waits until the
-    /// socket took it (and anything held back before it).
-    pub async fn send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
-        self.queue(q, enable)?;
+    /// Writes the six targets \[rad\], their time on the client's clock `stamp_s` \[s\] and the
+    /// enable flag in one data package and waits until the socket took it (and anything held back
+    /// before it).
+    pub async fn send(&mut self, q: [f64; 6], stamp_s: f64, enable: bool) -> Result<(), String> {
+        self.queue(q, stamp_s, enable)?;
         self.writer.write_all(&self.unsent).await.map_err(err)?;
         self.unsent.clear();
         Ok(())
@@ -171,8 +172,8 @@ impl UrClient {
     /// Writes the package without waiting: what the socket does not take now is held back and
     /// goes first next time. Fails if the controller stops reading (more than 2 KiB
     /// held back) or the connection broke.
-    pub fn try_send(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
-        self.queue(q, enable)?;
+    pub fn try_send(&mut self, q: [f64; 6], stamp_s: f64, enable: bool) -> Result<(), String> {
+        self.queue(q, stamp_s, enable)?;
         while !self.unsent.is_empty() {
             match self.writer.try_write(&self.unsent) {
                 Ok(n) => drop(self.unsent.drain(..n)),
@@ -186,9 +187,11 @@ impl UrClient {
         Ok(())
     }
 
-    /// Appends the input data package for `q` and `enable` to the bytes to send.
-    fn queue(&mut self, q: [f64; 6], enable: bool) -> Result<(), String> {
+    /// Appends the input data package for `q`, `stamp_s` and `enable` to the bytes to send (in
+    /// [`urscript::input_names`] order).
+    fn queue(&mut self, q: [f64; 6], stamp_s: f64, enable: bool) -> Result<(), String> {
         let mut values: Vec<RtdeValue> = q.iter().map(|&v| RtdeValue::Double(v)).collect();
+        values.push(RtdeValue::Double(stamp_s));
         values.push(RtdeValue::Int32(i32::from(enable)));
         let packet = self.session.input_data(self.input_recipe, &values).map_err(err)?;
         self.unsent.extend_from_slice(&packet.encode().map_err(err)?);

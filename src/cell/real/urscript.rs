@@ -11,11 +11,25 @@
 //!
 //! The program (`urscript/follow.script`, written by this project) loops forever:
 //! - `input_int_register_24` = 1: read the six joint targets from `input_double_register_24..29`
-//!   \[rad\] and `servoj` towards them every 2 ms controller cycle, `output_int_register_24` = 1.
-//!   A new target is reached in even steps over as many cycles as the one before took to arrive
-//!   (the client's tick, about 5 cycles), so `servoj` sees a new setpoint every cycle rather than a
-//!   step every fifth one; the cost is one client tick of lag;
-//! - anything else: `stopj(2.0)` (2 rad/s² deceleration), `output_int_register_24` = 0.
+//!   \[rad\] and their time on the client's clock from `input_double_register_30` \[s\] (a new
+//!   time is a new target), and `servoj` every 2 ms controller cycle to the targets played back at
+//!   their own times: on the controller's clock, `delay` (30 ms) behind the earliest any target
+//!   arrived (the smallest controller-minus-client time seen; when no target came as early for a
+//!   second it forgets at 1 ms/s, so the two clocks may drift apart), interpolated between the two targets around the playback time (eight kept).
+//!   A target that arrives up to `delay` less one client tick late (20 ms at 100 Hz), or bunched
+//!   with others, moves the arm exactly as one on time would. Past the newest target the playback
+//!   goes on along the last two for at most 0.1 s (a client's watchdog stops sooner), then holds.
+//!   `output_int_register_24` = 1.
+//! - anything else: `stopj(2.0)` (2 rad/s² deceleration), `output_int_register_24` = 0; the next
+//!   enabled target starts the playback afresh.
+//!
+//! Why stamped targets: the program before played each new target over as many cycles as the one
+//! before took to arrive. On an ordinary PC a package is now and then several milliseconds late and
+//! the next follows at once; that stretched one target over too many cycles and squeezed the next
+//! into too few, and the arm's speed jumped. Against the virtual devices with 5-20 ms stalls twice
+//! a second on the RTDE inputs alone (`--jitter busy-pc`), the lift's force estimate fell to
+//! 0.17 N at its 5th percentile (the twin: 0.54 N) while the other links' jitter changed nothing;
+//! docs/hardware.md, "Timing on an ordinary PC".
 //!
 //! From the first enabled target on, `rtde_set_watchdog("input_int_register_24", 2, "stop")`
 //! (URScript manual: `rtde_set_watchdog(variable_name, min_frequency, action="pause")`, actions
@@ -23,14 +37,13 @@
 //! client writes no package with the enable register for more than 0.5 s (it writes one every
 //! control tick, about 100 Hz). Armed only once enabled, because our client uploads the program
 //! at configure and streams targets only from the first tick on. Why 2 Hz and not faster: the
-//! client's own watchdogs stop a run on a 10 ms stall already (`RealCell`), so this one is only the
-//! backstop for a client that died, whose last target is at most one tick's step ahead of the arm;
-//! and the real-time tests tolerate 400 ms stalls of a shared machine (`LOOSE_WATCHDOG_S`), which a
-//! 10 Hz watchdog would turn into stopped runs.
+//! client's own watchdogs stop a run on a stream stalled for 0.1 s already (`RealCell`), so this one is only the
+//! backstop for a client that died (it plays the targets it has, then holds), and a stalled shared
+//! machine (400 ms seen) would turn a 10 Hz watchdog into stopped runs.
 //!
-//! Registers 24..29 leave 0..23 free for SDU's `ur_rtde`, whose control script uses the lower half.
-//! The client writes the targets and the enable flag in one RTDE input recipe, so a target and its
-//! enable always arrive together; speed and acceleration limits are applied before (see
+//! Registers 24..30 leave 0..23 free for SDU's `ur_rtde`, whose control script uses the lower half.
+//! The client writes the targets, their time and the enable flag in one RTDE input recipe, so they
+//! always arrive together; speed and acceleration limits are applied before (see
 //! [`crate::cell::real::limits`]). The controller's own safety limits still apply on top.
 
 pub mod ast;
@@ -67,14 +80,17 @@ pub const FOLLOW_SCRIPT: &str = include_str!("urscript/follow.script");
 
 /// First input double register holding a joint target (six consecutive registers).
 pub const TARGET_REGISTER: usize = 24;
+/// Input double register holding the target's time on the client's clock \[s\].
+pub const STAMP_REGISTER: usize = 30;
 /// Input int register holding the enable flag (1 follow, 0 stop).
 pub const ENABLE_REGISTER: usize = 24;
 /// Output int register the program sets to 1 while following.
 pub const FOLLOWING_REGISTER: usize = 24;
 
-/// RTDE input names in recipe order: six targets, then the enable flag.
+/// RTDE input names in recipe order: six targets, their time, then the enable flag.
 pub fn input_names() -> Vec<String> {
     let mut names: Vec<String> = (0..6).map(|i| format!("input_double_register_{}", TARGET_REGISTER + i)).collect();
+    names.push(format!("input_double_register_{STAMP_REGISTER}"));
     names.push(format!("input_int_register_{ENABLE_REGISTER}"));
     names
 }

@@ -24,10 +24,12 @@
 
 pub mod dashboard;
 pub mod io;
+pub mod jitter;
 mod net;
 pub mod pose;
 pub mod program;
 pub mod safety;
+mod setpoint;
 mod twin;
 
 use crate::cell::real::HardwareConfig;
@@ -40,6 +42,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 pub use dashboard::{UrController, VirtualUrSetup};
+pub use jitter::{Jitter, JitterModel, JitterProfile};
 pub use twin::{DeviceState, ProgramState, TwinStatus};
 
 /// Where the virtual devices listen and how fast the twin runs.
@@ -71,6 +74,9 @@ pub struct ServeConfig {
     /// An RTDE or HYPERION command connection on which nothing is received or sent for this long is
     /// closed (default [`IDLE_TIMEOUT`]); see `docs/hardware.md`.
     pub idle_timeout: Duration,
+    /// Timing faults injected into the RTDE streams (both ways), the peak stream and the Dynamixel
+    /// bus ([`jitter`]; default none).
+    pub jitter: Option<Jitter>,
 }
 
 /// How long an RTDE or HYPERION command connection may stay silent both ways before the virtual
@@ -95,6 +101,21 @@ impl ServeConfig {
             period_s: 1e-3,
             realtime: RealtimeOptions::default(),
             idle_timeout: IDLE_TIMEOUT,
+            jitter: None,
+        }
+    }
+
+    /// [`ServeConfig::loopback`] on ports the system picks (each listener its own free port; the
+    /// [`ServeHandle`] tells which): for runs and tests side by side that must not collide.
+    pub fn ephemeral() -> ServeConfig {
+        ServeConfig {
+            rtde_port: 0,
+            script_port: 0,
+            realtime_script_port: 0,
+            dashboard_port: 0,
+            command_port: 0,
+            stream_port: 0,
+            ..ServeConfig::loopback()
         }
     }
 
@@ -189,8 +210,10 @@ pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Resu
             let _ = rt.apply_to_current_thread();
         })
         .build()?;
-    let (addrs, ur_addrs) = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe()))?;
-    let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone(), rt)?;
+    // Time 0 of the injected jitter's clock.
+    let epoch = std::time::Instant::now();
+    let (addrs, ur_addrs) = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe(), epoch))?;
+    let (pty_path, bus) = twin::open_bus(state.clone(), stop.clone(), rt, config.jitter, epoch)?;
     let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone(), rt)?;
     Ok(ServeHandle {
         pty_path,

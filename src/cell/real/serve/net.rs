@@ -1,6 +1,7 @@
 //! The TCP side of the virtual devices: RTDE, URScript upload, HYPERION commands and stream.
 
 use super::dashboard::answer;
+use super::jitter::{Held, Link};
 use super::twin::DeviceState;
 use super::twin::ProgramState;
 use super::{ServeConfig, UrAddrs};
@@ -9,7 +10,7 @@ use crate::cell::real::protocol::rtde::{ServerConfig, ServerSession};
 use crate::cell::real::urscript::is_complete_program;
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::watch;
@@ -33,6 +34,7 @@ pub async fn listen_all(
     c: &ServeConfig,
     state: Shared,
     ticks: watch::Receiver<u64>,
+    epoch: Instant,
 ) -> anyhow::Result<([SocketAddr; 4], UrAddrs)> {
     let bind = |port| async move {
         TcpListener::bind(SocketAddr::new(c.bind, port))
@@ -47,10 +49,13 @@ pub async fn listen_all(
     let realtime_script = bind(c.realtime_script_port).await?;
     let addrs = [rtde.local_addr()?, script.local_addr()?, command.local_addr()?, stream.local_addr()?];
     let ur_addrs = UrAddrs { dashboard: dashboard.local_addr()?, realtime_script: realtime_script.local_addr()? };
-    let idle = c.idle_timeout;
+    let (idle, jitter) = (c.idle_timeout, c.jitter);
     {
         let (state, ticks) = (state.clone(), ticks.clone());
-        tokio::spawn(accept(rtde, move |s| serve_rtde(s, state.clone(), ticks.clone(), idle)));
+        tokio::spawn(accept(rtde, move |s| {
+            let links = (Held::new(jitter, Link::RtdeIn, epoch), Held::new(jitter, Link::RtdeOut, epoch));
+            serve_rtde(s, state.clone(), ticks.clone(), idle, links)
+        }));
     }
     for listener in [script, realtime_script] {
         let state = state.clone();
@@ -64,7 +69,9 @@ pub async fn listen_all(
         let state = state.clone();
         tokio::spawn(accept(command, move |s| serve_commands(s, state.clone(), idle)));
     }
-    tokio::spawn(accept(stream, move |s| serve_stream(s, state.clone(), ticks.clone())));
+    tokio::spawn(accept(stream, move |s| {
+        serve_stream(s, state.clone(), ticks.clone(), Held::new(jitter, Link::Peaks, epoch))
+    }));
     Ok((addrs, ur_addrs))
 }
 
@@ -87,12 +94,20 @@ where
 
 /// One RTDE connection: replies to requests; data packages on each twin tick while started.
 /// Closed after `idle` with nothing received or sent (a started session sends every tick).
-async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>, idle: Duration) {
+/// `links` hold back what arrives and what is sent, when jitter is injected.
+async fn serve_rtde(
+    mut socket: TcpStream,
+    state: Shared,
+    mut ticks: watch::Receiver<u64>,
+    idle: Duration,
+    links: (Held<Vec<u8>>, Held<Vec<u8>>),
+) {
     let id = {
         let mut s = lock(&state);
         s.next_session += 1;
         s.next_session
     };
+    let (mut arriving, mut leaving) = links;
     let mut session = ServerSession::new(id, ServerConfig::default());
     let mut buf = Vec::new();
     let mut chunk = vec![0u8; 16 * 1024];
@@ -102,16 +117,27 @@ async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Rece
             () = tokio::time::sleep_until(last_activity + idle) => break,
             r = socket.read(&mut chunk) => match r {
                 Ok(n) if n > 0 => {
-                    buf.extend_from_slice(&chunk[..n]);
                     last_activity = tokio::time::Instant::now();
-                    let mut s = lock(&state);
-                    match session.feed(&mut buf, &mut s.inputs) {
-                        Ok(out) if buf.len() <= MAX_PENDING => out,
-                        _ => break, // malformed or oversized: close, as the controller does
+                    match arriving.push(chunk[..n].to_vec()) {
+                        Some(bytes) => match feed(&mut session, &mut buf, &bytes, &state) {
+                            Some(out) => out,
+                            None => break, // malformed or oversized: close, as the controller does
+                        },
+                        None => Vec::new(),
                     }
                 }
                 _ => break,
             },
+            () = sleep_until(arriving.next_release()), if arriving.next_release().is_some() => {
+                let mut out = Vec::new();
+                for bytes in arriving.due() {
+                    match feed(&mut session, &mut buf, &bytes, &state) {
+                        Some(more) => out.extend(more),
+                        None => return lock(&state).inputs.release(id),
+                    }
+                }
+                out
+            }
             changed = ticks.changed() => {
                 if changed.is_err() {
                     break;
@@ -125,7 +151,10 @@ async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Rece
                         out.extend_from_slice(&bytes);
                     }
                 }
-                out
+                if out.is_empty() { out } else { leaving.push(out).unwrap_or_default() }
+            }
+            () = sleep_until(leaving.next_release()), if leaving.next_release().is_some() => {
+                leaving.due().concat()
             }
         };
         if !out.is_empty() {
@@ -136,6 +165,25 @@ async fn serve_rtde(mut socket: TcpStream, state: Shared, mut ticks: watch::Rece
         }
     }
     lock(&state).inputs.release(id);
+}
+
+/// Feeds bytes an RTDE client sent to its session; the replies, or `None` when the input is
+/// malformed or a frame grows past [`MAX_PENDING`].
+fn feed(session: &mut ServerSession, buf: &mut Vec<u8>, bytes: &[u8], state: &Shared) -> Option<Vec<u8>> {
+    buf.extend_from_slice(bytes);
+    let mut s = lock(state);
+    match session.feed(buf, &mut s.inputs) {
+        Ok(out) if buf.len() <= MAX_PENDING => Some(out),
+        _ => None,
+    }
+}
+
+/// Sleeps until `at` (never returns when there is nothing held: the `select!` guard keeps it off).
+async fn sleep_until(at: Option<Instant>) {
+    match at {
+        Some(at) => tokio::time::sleep_until(tokio::time::Instant::from_std(at)).await,
+        None => std::future::pending().await,
+    }
 }
 
 /// The secondary interface: a complete `def ... end` program replaces the running one and plays.
@@ -232,21 +280,36 @@ async fn serve_commands(mut socket: TcpStream, state: Shared, idle: Duration) {
 
 /// HYPERION peak stream: after each twin tick, every scan since the last one sent (a reader that
 /// keeps up gets consecutive serial numbers; one more than the backlog behind loses the oldest).
-async fn serve_stream(mut socket: TcpStream, state: Shared, mut ticks: watch::Receiver<u64>) {
+/// `leaving` holds frames back when jitter is injected.
+async fn serve_stream(
+    mut socket: TcpStream,
+    state: Shared,
+    mut ticks: watch::Receiver<u64>,
+    mut leaving: Held<Vec<u8>>,
+) {
     let mut sent = None;
-    while ticks.changed().await.is_ok() {
-        let bytes = {
-            let s = lock(&state);
-            s.interrogator.stream_after(sent)
-        };
-        match bytes {
-            Ok((bytes, last)) => {
-                sent = last;
-                if !bytes.is_empty() && socket.write_all(&bytes).await.is_err() {
+    loop {
+        let bytes = tokio::select! {
+            changed = ticks.changed() => {
+                if changed.is_err() {
                     return;
                 }
+                let bytes = {
+                    let s = lock(&state);
+                    s.interrogator.stream_after(sent)
+                };
+                match bytes {
+                    Ok((bytes, last)) => {
+                        sent = last;
+                        if bytes.is_empty() { bytes } else { leaving.push(bytes).unwrap_or_default() }
+                    }
+                    Err(_) => return,
+                }
             }
-            Err(_) => return,
+            () = sleep_until(leaving.next_release()), if leaving.next_release().is_some() => leaving.due().concat(),
+        };
+        if !bytes.is_empty() && socket.write_all(&bytes).await.is_err() {
+            return;
         }
     }
 }

@@ -30,9 +30,15 @@ pub const LOG_LINES: usize = 500;
 pub enum ArmCommand {
     /// Keep the last command.
     Keep,
-    /// Move to these joint angles \[rad\] (a `servoj` target: the twin's arm reaches it one
-    /// program cycle later at a constant speed from the previous target, whatever its physics step).
-    Move([f64; 6]),
+    /// A `servoj` target: joint angles \[rad\] given by the program's cycle at twin time `at_s`
+    /// \[s\]. The twin's arm passes through each target at a fixed delay after its cycle, moving
+    /// linearly from one target to the next (see the twin's `ServoPath`), whatever its physics step.
+    Servo {
+        /// Target \[rad\].
+        q: [f64; 6],
+        /// The program cycle that gave it \[s\].
+        at_s: f64,
+    },
     /// Follow a generated trajectory: the setpoint `q` \[rad\] at twin time `at_s` \[s\] moving at
     /// `qd` \[rad/s\]. The twin commands the setpoint extrapolated to the end of each physics step:
     /// commanding every 2 ms cycle against 5 ms physics steps would move the arm by two cycles'
@@ -176,7 +182,7 @@ impl ProgramRunner {
         }
         let Some(q) = command else { return ArmCommand::Keep };
         match super::safety::violation(&q, &measured_q) {
-            None if servoing => ArmCommand::Move(q),
+            None if servoing => ArmCommand::Servo { q, at_s: cycle_s },
             None => ArmCommand::Track { q, qd, at_s: cycle_s },
             Some(why) => {
                 // Protective stop: the arm stops where it is, the program stops.

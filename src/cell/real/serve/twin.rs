@@ -1,8 +1,10 @@
 //! The twin thread (SimCell in real time) and the Dynamixel bus on a pseudo-terminal.
 
 use super::dashboard::{UrController, VirtualUrSetup};
+use super::jitter::{Held, Jitter, Link};
 use super::pose::tcp_pose;
 use super::program::{ArmCommand, ProgramRunner};
+use super::setpoint::{ArmPath, servo_delay_s};
 use crate::cell::fbg::SpectralConfig;
 use crate::cell::physics::SceneModel;
 use crate::cell::real::HardwareConfig;
@@ -172,6 +174,8 @@ pub fn open_bus(
     state: Arc<Mutex<DeviceState>>,
     stop: Arc<AtomicBool>,
     realtime: RealtimeOptions,
+    jitter: Option<Jitter>,
+    epoch: Instant,
 ) -> anyhow::Result<(PathBuf, std::thread::JoinHandle<()>)> {
     use std::os::unix::io::AsRawFd;
     let (mut master, slave) = serial2::SerialPort::pair()?;
@@ -184,9 +188,17 @@ pub fn open_bus(
         let _ = realtime.apply_to_current_thread();
         let mut decoder = StreamDecoder::new();
         let mut chunk = [0u8; 1024];
+        // Injected jitter holds each request back (and with it the reply and whatever comes behind).
+        let mut link = Held::new(jitter, Link::Bus, epoch);
         while !stop.load(Ordering::SeqCst) {
             match master.read(&mut chunk) {
                 Ok(n) if n > 0 => {
+                    if link.push(()).is_none() {
+                        if let Some(at) = link.next_release() {
+                            std::thread::sleep(at.saturating_duration_since(Instant::now()));
+                        }
+                        link.due();
+                    }
                     let reply = lock(&state).bus.respond_to_bytes(&mut decoder, &chunk[..n]);
                     if !reply.is_empty() && master.write_all(&reply).is_err() {
                         return;
@@ -222,38 +234,6 @@ fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64,
     (t, std::array::from_fn(|j| before.1[j] + (after.1[j] - before.1[j]) * f))
 }
 
-/// A setpoint moving at a constant speed, which the twin samples at the end of each physics step.
-#[derive(Debug, Clone, Copy)]
-struct Tracking {
-    /// Joint angles at `at_s` \[rad\].
-    q: [f64; 6],
-    /// Their speed \[rad/s\].
-    qd: [f64; 6],
-    /// Twin time of `q` \[s\].
-    at_s: f64,
-    /// How far past `at_s` the setpoint moves on \[s\].
-    max_ahead_s: f64,
-}
-
-impl Tracking {
-    /// A `servoj` target: reached one program cycle after it is given, at a constant speed from
-    /// where the previous target left the arm (servoj's `t` of one cycle). Commanding the target at
-    /// the next physics step instead made the arm's speed depend on how many steps fell in each
-    /// cycle: with 1.25 ms steps and 2 ms cycles (the default step then) it moved one cycle's way in
-    /// 1.25 ms, then in 2.5 ms, and the shaking let a held crimper go in the short lift (the estimate 0.15-1.6 N
-    /// against 0.53-0.58 N on the simulated path; measured).
-    fn servo(from: [f64; 6], to: [f64; 6], now_s: f64) -> Tracking {
-        let qd = std::array::from_fn(|j| (to[j] - from[j]) / CONTROL_PERIOD_S);
-        Tracking { q: from, qd, at_s: now_s, max_ahead_s: CONTROL_PERIOD_S }
-    }
-
-    /// The setpoint at twin time `t_s`, held at its end once `max_ahead_s` has passed.
-    fn at(&self, t_s: f64) -> [f64; 6] {
-        let ahead = (t_s - self.at_s).clamp(0.0, self.max_ahead_s);
-        std::array::from_fn(|j| self.q[j] + self.qd[j] * ahead)
-    }
-}
-
 /// Runs the twin in real time on its own thread (the MuJoCo data stays on it).
 pub fn spawn(
     scenario: PickPlaceScenario,
@@ -266,6 +246,7 @@ pub fn spawn(
     let model = SceneModel::build(&scenario.scene_spec())?;
     let motors = scenario.hardware.motor_ids();
     let channel = scenario.hardware.fbg.channel;
+    let (ready, started) = std::sync::mpsc::sync_channel(1);
     let run = move || -> Result<(), String> {
         let _ = realtime.apply_to_current_thread();
         // Built here: the simulation's data stays on this thread.
@@ -294,10 +275,10 @@ pub fn spawn(
         let mut measured_q = first.arm_q;
         // The virtual controller's program (the URScript interpreter).
         let mut program = ProgramRunner::default();
-        // The setpoint the arm follows between program cycles: where it is at a time, its speed,
-        // and how far past that time it may be extrapolated (see `ArmCommand::Track` and `Move`).
-        let mut tracking: Option<Tracking> = None;
+        // The path the arm's setpoint follows between program cycles (see `ArmPath`).
+        let mut path: Option<ArmPath> = None;
         let timestep_s = scenario.physics.timestep_s;
+        let servo_delay_s = servo_delay_s(period_s, timestep_s);
         {
             let mut s = lock(&state);
             for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
@@ -312,6 +293,8 @@ pub fn spawn(
             s.outputs.actual_tcp_pose = tcp_pose(&first.arm_q, &s.outputs.tcp_offset);
             s.outputs.target_tcp_pose = s.outputs.actual_tcp_pose;
         }
+        // The devices now answer as the twin stands: `spawn` may return.
+        let _ = ready.send(());
         let started = Instant::now();
         for k in 1u64.. {
             if stop.load(Ordering::SeqCst) {
@@ -328,15 +311,15 @@ pub fn spawn(
                     ArmCommand::Keep => false,
                     ArmCommand::Track { q, qd, at_s } => {
                         // Never more than a step and a cycle ahead of the program's last setpoint.
-                        tracking = Some(Tracking { q, qd, at_s, max_ahead_s: timestep_s + CONTROL_PERIOD_S });
+                        path = Some(ArmPath::Track { q, qd, at_s, max_ahead_s: timestep_s + CONTROL_PERIOD_S });
                         false
                     }
-                    ArmCommand::Move(q) => {
-                        tracking = Some(Tracking::servo(command.arm_q, q, now_s));
+                    ArmCommand::Servo { q, at_s } => {
+                        path = Some(ArmPath::servo(path.take(), q, at_s, servo_delay_s, (command.arm_q, last_step.0)));
                         false
                     }
                     ArmCommand::Hold => {
-                        tracking = None;
+                        path = None;
                         command.arm_q = measured_q;
                         true
                     }
@@ -344,13 +327,13 @@ pub fn spawn(
                 // The physics steps in this tick's wait: command the trajectory's setpoint at the
                 // step's end (a step is due once the wait passes half of it, as `wait_until` runs).
                 let physics_s = last_step.0;
-                if let Some(t) = tracking
+                if let Some(p) = &path
                     && k as f64 * period_s - physics_s > 0.5 * timestep_s
                 {
-                    command.arm_q = t.at(physics_s + timestep_s);
+                    command.arm_q = p.at(physics_s + timestep_s);
                     new = true;
-                    if t.qd.iter().all(|v| *v == 0.0) {
-                        tracking = None;
+                    if p.settled_after(physics_s + timestep_s) {
+                        path = None;
                     }
                 }
                 for (id, slot) in motors.into_iter().zip([&mut command.growth_motor_rad, &mut command.twine_motor_rad])
@@ -451,7 +434,17 @@ pub fn spawn(
         }
         Ok(())
     };
-    Ok(std::thread::Builder::new().name("twin".into()).spawn(run)?)
+    let twin = std::thread::Builder::new().name("twin".into()).spawn(run)?;
+    // Until the twin has put its first state into the devices, they would answer with their
+    // power-on defaults: a client that read the motors' positions then (seen on a loaded machine,
+    // the twin thread not yet run) took 0 ticks, half a turn off, for the set-up position.
+    if started.recv().is_err() {
+        return match twin.join() {
+            Ok(Err(e)) => Err(anyhow::anyhow!("twin: {e}")),
+            _ => Err(anyhow::anyhow!("twin: stopped before it started")),
+        };
+    }
+    Ok(twin)
 }
 
 #[cfg(test)]

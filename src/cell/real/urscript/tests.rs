@@ -86,11 +86,19 @@ fn program(body: &str) -> String {
 fn the_follow_script_is_a_complete_program_using_the_documented_registers() {
     assert!(is_complete_program(FOLLOW_SCRIPT));
     assert!(FOLLOW_SCRIPT.contains("read_input_integer_register(24)"));
-    for i in 24..30 {
+    for i in 24..=30 {
         assert!(FOLLOW_SCRIPT.contains(&format!("read_input_float_register({i})")));
     }
     assert!(!is_complete_program("def f():\n  stopj(1)\n"));
-    assert_eq!(input_names().len(), 7);
+    assert_eq!(input_names().len(), 8);
+    assert_eq!(input_names()[6], format!("input_double_register_{STAMP_REGISTER}"));
+}
+
+/// Writes a target and its time as one RTDE package would.
+fn deliver(fake: &mut Fake, q0: f64, stamp_s: f64) {
+    fake.in_float[TARGET_REGISTER] = q0;
+    fake.in_float[STAMP_REGISTER] = stamp_s;
+    fake.packages += 1;
 }
 
 #[test]
@@ -100,20 +108,21 @@ fn the_follow_script_follows_the_registers_while_enabled_and_arms_a_2_hz_stop_wa
     assert!(run(&mut p, &mut fake, 0, 10).is_empty(), "disabled: nothing commanded");
     assert_eq!(fake.out_int[FOLLOWING_REGISTER], 0);
     assert_eq!(fake.watchdog, None, "not armed before enable");
-    // Enabled, a new target per package.
+    // Enabled: the first target is held at once (it is where the arm is, on a client that starts
+    // from the measured pose).
     fake.in_int[ENABLE_REGISTER] = 1;
     for j in 0..6 {
         fake.in_float[TARGET_REGISTER + j] = 0.01 * (j + 1) as f64;
     }
-    fake.packages = 1;
+    deliver(&mut fake, 0.01, 0.0);
     let commands = run(&mut p, &mut fake, 10, 5);
-    assert_eq!(commands.len(), 1, "one command per new package: {commands:?}");
+    assert_eq!(commands.len(), 1, "one command for the new package: {commands:?}");
     assert_eq!(commands[0].1[5], 0.06);
     assert_eq!(fake.out_int[FOLLOWING_REGISTER], 1);
     let w = fake.watchdog.clone().unwrap();
     assert_eq!(w.variable, format!("input_int_register_{ENABLE_REGISTER}"));
     assert_eq!((w.min_frequency_hz, w.action), (2.0, WatchdogAction::Stop));
-    fake.packages = 2;
+    fake.packages += 1;
     assert_eq!(run(&mut p, &mut fake, 15, 2).len(), 1, "a new package re-commands the same target");
     // Disabled: stop, acknowledge 0, no further commands (the servo target is held).
     fake.in_int[ENABLE_REGISTER] = 0;
@@ -122,27 +131,46 @@ fn the_follow_script_follows_the_registers_while_enabled_and_arms_a_2_hz_stop_wa
     assert_eq!(p.status(), &Status::Running);
 }
 
-#[test]
-fn the_follow_script_spreads_each_new_target_over_the_cycles_the_last_one_took() {
+/// A 100 Hz client's targets on a ramp at 0.5 rad/s, each delivered `late(k)` cycles after its
+/// time (late ones bunch with the next): the commanded joint 0 per 2 ms cycle, from cycle 0.
+fn play_ramp(late: impl Fn(usize) -> usize, ticks: usize) -> Vec<f64> {
     let mut fake = Fake::new();
     let mut p = Interpreter::new(FOLLOW_SCRIPT, [0.0; 6]).unwrap();
     fake.in_int[ENABLE_REGISTER] = 1;
-    fake.in_float[TARGET_REGISTER] = 0.1;
-    fake.packages = 1;
-    let first = run(&mut p, &mut fake, 0, 5);
-    assert_eq!(first.len(), 1, "the first target at once: {first:?}");
-    assert_eq!(first[0].1[0], 0.1);
-    // The next target 5 cycles later (a 100 Hz client against the 500 Hz controller): one
-    // evenly spaced setpoint per cycle, reaching it after 5 cycles, then held.
-    fake.in_float[TARGET_REGISTER] = 0.2;
-    fake.packages = 2;
-    let spread = run(&mut p, &mut fake, 5, 8);
-    let joint0: Vec<f64> = spread.iter().map(|(_, q)| q[0]).collect();
-    assert_eq!(joint0.len(), 5, "a setpoint per cycle until the target: {spread:?}");
-    for (i, q) in joint0.iter().enumerate() {
-        let want = 0.1 + 0.1 * (i + 1) as f64 / 5.0;
-        assert!((q - want).abs() < 1e-12, "cycle {i}: {q} against {want}");
+    let mut q = Vec::new();
+    let mut delivered = 0;
+    for cycle in 0..ticks * 5 + 100 {
+        // Every target due by this cycle, in order; a late one holds back those behind it.
+        while delivered < ticks && delivered * 5 + late(delivered) <= cycle {
+            let t = delivered as f64 * 0.01;
+            deliver(&mut fake, 0.5 * t, t);
+            delivered += 1;
+        }
+        run(&mut p, &mut fake, cycle, 1);
+        q.push(fake.q[0]);
     }
+    q
+}
+
+#[test]
+fn the_follow_script_plays_stamped_targets_back_at_their_times_however_late_they_arrive() {
+    let on_time = play_ramp(|_| 0, 100);
+    // Late by up to 15 ms (the program absorbs 20 ms at 100 Hz), several bunched together.
+    let jittered = play_ramp(|k| [0, 7, 3, 0, 0, 7, 7, 1, 0, 4][k % 10], 100);
+    // After the playback's start (30 ms behind the first target), one cycle's way per cycle.
+    let moving = &on_time[20..400];
+    for w in moving.windows(2) {
+        assert!((w[1] - w[0] - 0.5 * CONTROL_PERIOD_S).abs() < 1e-12, "{w:?}");
+    }
+    assert_eq!(on_time[..450], jittered[..450], "late and bunched targets move the arm as on time");
+    // The newest target is played 30 ms (15 cycles) after the cycle its time came round (the
+    // earliest arrival was in that cycle).
+    let last = 0.5 * 0.99;
+    let at = on_time.iter().position(|&q| (q - last).abs() < 1e-12).unwrap();
+    assert_eq!(at, 495 + 15);
+    // Without newer targets, the playback goes on along the last two for 0.1 s, then holds.
+    let end = on_time.last().unwrap();
+    assert!((end - (last + 0.5 * 0.1)).abs() < 1e-9, "{end}");
 }
 
 #[test]
