@@ -12,8 +12,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
-use tendril::cell::physics::validation::ValidationRun;
-use tendril::cell::physics::{ArmMode, Backend, Physics, PhysicsConfig, SceneModel, SceneSpec, ur5e, validation};
+use tendril_twin::physics::validation::ValidationRun;
+use tendril_twin::physics::{ArmMode, Backend, Physics, PhysicsConfig, SceneModel, SceneSpec, validation};
+use tendril_ur5e::kinematics as ur5e;
 
 /// A scene already holding the object: grown (3.5 s at the motor's speed), twined to 32 mm at a steady
 /// 7.5 mm/s (4.3 s), settled (0.5 s).

@@ -5,14 +5,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tendril::cell::real::protocol::Decoded;
-use tendril::cell::real::protocol::dynamixel::{
-    BROADCAST_ID, Instruction, InstructionPacket, StreamDecoder, VirtualBus,
-};
-use tendril::cell::real::protocol::hyperion::{PeakFrame, Response, decode_stream_frame};
-use tendril::cell::real::protocol::rtde::{
-    ClientPacket, ClientSession, RobotOutputs, ServerConfig, ServerSession, SharedInputs, fields,
-};
+use tendril_codec::Decoded;
+use tendril_dynamixel::{BROADCAST_ID, Instruction, InstructionPacket, StreamDecoder, VirtualBus};
+use tendril_hyperion::{PeakFrame, Response, decode_stream_frame};
+use tendril_rtde::{ClientPacket, ClientSession, RobotOutputs, ServerConfig, ServerSession, SharedInputs, fields};
 
 fn rtde_tick(c: &mut Criterion) {
     let mut shared = SharedInputs::new();

@@ -7,24 +7,23 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::path::Path;
 use std::time::{Duration, Instant};
-use tendril::cell::physics::Backend;
-use tendril::run::execute::{ModelCache, run_on_twin};
-use tendril::run::scenario::PickPlaceScenario;
-use tendril::scenario::Override;
+use tendril_run::execute::{ModelCache, run_on_twin};
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_twin::physics::Backend;
 
 /// The shipped scenario on `backend`: MuJoCo at the converged default; rapier at 32 uniform links
 /// and a 5 ms step, the setting of README's rapier comparison (at 64 uniform links and 1.25 ms it
 /// runs at about 0.1x real time, and `cargo test --all-targets` runs every bench once).
 fn scenario(name: &str, backend: Backend) -> PickPlaceScenario {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
-    let mut overrides = vec![Override::backend(backend)];
+    let mut overrides = vec![backend.as_override()];
     if backend == Backend::Rapier {
         overrides.extend(
             ["finger.segments=32", "finger.base_refinement=1", "physics.timestep_s=0.005"]
                 .map(|s| s.parse().expect("valid")),
         );
     }
-    tendril::scenario::load(&file, &overrides).expect("shipped scenarios load")
+    tendril_config::load(&file, &overrides).expect("shipped scenarios load")
 }
 
 fn full_scenario(c: &mut Criterion) {

@@ -3,8 +3,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
-use tendril::cell::fbg::{FbgSensor, InterrogatorConfig, InterrogatorMode, SensorConfig};
-use tendril::control::estimate::{ForceCalibration, ForceEstimator};
+use tendril_fbg::estimate::{ForceCalibration, ForceEstimator};
+use tendril_fbg::{FbgSensor, InterrogatorConfig, InterrogatorMode, SensorConfig};
 
 const BATCH: u64 = 1000;
 

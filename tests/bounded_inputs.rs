@@ -3,8 +3,8 @@
 //! library's own load path (parse, `--set`, deserialise, validate).
 
 use std::path::{Path, PathBuf};
-use tendril::run::scenario::PickPlaceScenario;
-use tendril::scenario::{Override, ScenarioError};
+use tendril_config::{Override, ScenarioError};
+use tendril_run::scenario::PickPlaceScenario;
 
 fn crimper() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml")
@@ -12,7 +12,7 @@ fn crimper() -> PathBuf {
 
 fn load(sets: &[&str]) -> Result<PickPlaceScenario, ScenarioError> {
     let o: Vec<Override> = sets.iter().map(|s| s.parse().unwrap()).collect();
-    tendril::scenario::load(&crimper(), &o)
+    tendril_config::load(&crimper(), &o)
 }
 
 /// The key a failure names.
@@ -67,7 +67,7 @@ fn values_that_hung_or_were_accepted_are_refused_on_their_own_key() {
 fn the_defaults_and_the_shipped_scenarios_stay_valid() {
     for name in ["crimper", "hammer", "shampoo", "short-lift"] {
         let file = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{name}.toml"));
-        let r: Result<PickPlaceScenario, _> = tendril::scenario::load(&file, &[]);
+        let r: Result<PickPlaceScenario, _> = tendril_config::load(&file, &[]);
         assert!(r.is_ok(), "{name}: {:?}", r.err());
     }
     // The other engineer's ranges: timesteps down to 1e-4 s, up to 60 finger segments.
@@ -96,7 +96,7 @@ fn a_non_utf8_scenario_names_line_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("bad.toml");
     std::fs::write(&file, b"name = \"x\"\nsetpoint_n = 0.6 # \xff\n").unwrap();
-    let err = tendril::scenario::load::<PickPlaceScenario>(&file, &[]).unwrap_err();
+    let err = tendril_config::load::<PickPlaceScenario>(&file, &[]).unwrap_err();
     assert!(matches!(err, ScenarioError::Encoding { line: 2, column: 20, .. }), "{err}");
     assert!(err.to_string().contains("bad.toml: line 2, column 20"), "{err}");
 }
@@ -143,7 +143,7 @@ fn calibration_csvs_with_huge_frozen_or_gappy_values_fail_fast() {
     for (value, expect) in [("1e160", "outside"), ("1e300", "outside"), ("", "is empty"), ("nan", "not finite")] {
         let file = dir.path().join("bench.csv");
         std::fs::write(&file, set_cell(value)).unwrap();
-        let err = tendril::calibration::report::calibrate_file(&file).unwrap_err().to_string();
+        let err = tendril_fbg::calibration::report::calibrate_file(&file).unwrap_err().to_string();
         assert!(err.contains("bench.csv: line 101") && err.contains(expect), "{value}: {err}");
     }
     let frozen: String = rows
@@ -152,7 +152,7 @@ fn calibration_csvs_with_huge_frozen_or_gappy_values_fail_fast() {
         .map(|(i, l)| if i == 0 { format!("{l}\n") } else { format!("0{}\n", &l[l.find(',').unwrap()..]) })
         .collect();
     std::fs::write(dir.path().join("frozen.csv"), frozen).unwrap();
-    let err = tendril::calibration::report::calibrate_file(&dir.path().join("frozen.csv")).unwrap_err().to_string();
+    let err = tendril_fbg::calibration::report::calibrate_file(&dir.path().join("frozen.csv")).unwrap_err().to_string();
     assert!(err.contains("never advances"), "{err}");
     assert!(started.elapsed().as_secs_f64() < 10.0, "no spinning");
 }

@@ -5,16 +5,17 @@
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
-use tendril::control::controller::{ControlContext, ControllerConfig, ForceController};
-use tendril::control::estimate::ForceCalibration;
-use tendril::control::gripper::GripperConfig;
-use tendril::control::slip::SlipConfig;
-use tendril::control::task::{Phase, TaskConfig};
-use tendril::hardware::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, Lifecycle};
-use tendril::run::runner::{
+use tendril_cell::gripper::GripperConfig;
+use tendril_cell::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, Lifecycle};
+use tendril_control::ControllerConfig;
+use tendril_control::controller::{ControlContext, ForceController};
+use tendril_control::slip::SlipConfig;
+use tendril_control::task::{Phase, TaskConfig};
+use tendril_fbg::estimate::ForceCalibration;
+use tendril_fbg::signals::Wavelengths;
+use tendril_run::runner::{
     ControlPlan, MAX_CONSECUTIVE_INVALID_SAMPLES, Outcome, RunReport, run_task, run_task_with_controller,
 };
-use tendril::signals::Wavelengths;
 
 const RATE_HZ: f64 = 100.0;
 
@@ -155,7 +156,7 @@ impl ForceController for BangBang {
 fn run_bang_bang(feedback: bool) -> (RunReport, Seen) {
     let seen = Arc::new(Mutex::new(Seen::default()));
     let controller = Box::new(BangBang { speed_deg_s: 30.0, seen: seen.clone() });
-    let report = run_task_with_controller(&mut ToyCell::new(BTreeMap::new()), &plan(feedback), controller, None);
+    let report = run_task_with_controller(&mut ToyCell::new(BTreeMap::new()), &plan(feedback), controller);
     let seen = std::mem::take(&mut *seen.lock().unwrap());
     (report, seen)
 }
@@ -197,7 +198,7 @@ fn below_curve_sample() -> Wavelengths {
 
 #[test]
 fn invalid_samples_are_skipped_held_and_counted() {
-    let clean = run_task(&mut ToyCell::new(BTreeMap::new()), &plan(true), None);
+    let clean = run_task(&mut ToyCell::new(BTreeMap::new()), &plan(true));
     assert_eq!(clean.outcome, Outcome::Held, "{:?}", clean.error);
     assert_eq!(clean.invalid_samples, 0);
 
@@ -213,7 +214,7 @@ fn invalid_samples_are_skipped_held_and_counted() {
     for t in lift_tick..lift_tick + long {
         bad.insert(t, below_curve_sample());
     }
-    let report = run_task(&mut ToyCell::new(bad.clone()), &plan(true), None);
+    let report = run_task(&mut ToyCell::new(bad.clone()), &plan(true));
     assert_eq!(report.outcome, Outcome::Held, "{:?}", report.error);
     assert_eq!(report.error, None);
     assert_eq!(report.invalid_samples, bad.len() as u64);
@@ -231,7 +232,7 @@ fn invalid_samples_are_skipped_held_and_counted() {
 fn a_long_run_of_invalid_samples_ends_the_run() {
     let limit = u64::from(MAX_CONSECUTIVE_INVALID_SAMPLES);
     let bad: BTreeMap<u64, Wavelengths> = (600..600 + limit).map(|t| (t, below_curve_sample())).collect();
-    let report = run_task(&mut ToyCell::new(bad), &plan(true), None);
+    let report = run_task(&mut ToyCell::new(bad), &plan(true));
     assert_eq!(report.outcome, Outcome::Error);
     let error = report.error.clone().unwrap();
     assert!(error.contains(&format!("{limit} consecutive invalid samples")), "{error}");

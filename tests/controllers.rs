@@ -5,9 +5,9 @@
 mod common;
 
 use common::short_lift;
-use tendril::control::task::Phase;
-use tendril::run::execute::run_on_twin;
-use tendril::run::runner::{Outcome, RunReport};
+use tendril_control::task::Phase;
+use tendril_run::execute::run_on_twin;
+use tendril_run::runner::{Outcome, RunReport};
 
 fn run(overrides: &[&str]) -> RunReport {
     run_on_twin(&short_lift(overrides), &Default::default(), None).unwrap().1
@@ -64,7 +64,7 @@ fn a_knock_in_the_transfer_is_survived_by_its_size_whatever_the_controller() {
     // before any controller acts (README, "Disturbances").
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml");
     let knocked = |controller: &str, impulse: f64| {
-        let overrides: Vec<tendril::scenario::Override> = [
+        let overrides: Vec<tendril_config::Override> = [
             format!("controller.type=\"{controller}\""),
             "task.minimum_durations=false".into(),
             format!("disturbance.push.impulse_n_s={impulse}"),
@@ -74,7 +74,7 @@ fn a_knock_in_the_transfer_is_survived_by_its_size_whatever_the_controller() {
         .iter()
         .map(|o| o.parse().unwrap())
         .collect();
-        let scenario = tendril::scenario::load(&path, &overrides).unwrap();
+        let scenario = tendril_config::load(&path, &overrides).unwrap();
         run_on_twin(&scenario, &Default::default(), None).unwrap().1
     };
     for controller in ["pid", "feedforward"] {

@@ -6,14 +6,14 @@ mod common;
 
 use common::short_lift;
 use std::path::Path;
-use tendril::cell::real::RealCellConfig;
-use tendril::control::task::Phase;
-use tendril::run::execute::run_on_twin;
-use tendril::run::real::run_on_real;
-use tendril::run::runner::RunReport;
-use tendril::run::scenario::PickPlaceScenario;
-use tendril::run::trace::TraceRow;
-use tendril::scenario::ScenarioError;
+use tendril_config::ScenarioError;
+use tendril_control::task::Phase;
+use tendril_drivers::RealCellConfig;
+use tendril_run::execute::run_on_twin;
+use tendril_run::real::run_on_real;
+use tendril_run::runner::RunReport;
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::trace::TraceRow;
 
 fn run(overrides: &[&str]) -> RunReport {
     run_on_twin(&short_lift(overrides), &Default::default(), None).unwrap().1
@@ -109,8 +109,8 @@ fn without_minimum_durations_the_lift_is_planned_at_the_limits() {
 
 fn refused(overrides: &[&str]) -> (String, String) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(common::SHORT_LIFT);
-    let overrides: Vec<tendril::scenario::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
-    match tendril::scenario::load::<PickPlaceScenario>(&path, &overrides) {
+    let overrides: Vec<tendril_config::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    match tendril_config::load::<PickPlaceScenario>(&path, &overrides) {
         Err(ScenarioError::Invalid { key, reason, .. }) => (key, reason),
         other => panic!("{overrides:?}: not refused: {other:?}"),
     }

@@ -315,7 +315,7 @@ fn the_shipped_tune_files_load() {
         let path = entry.unwrap().path();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         if name.starts_with("tune-") && name.ends_with(".toml") {
-            tendril::fit::tune::load_tune(&path, &tendril::scenario::Overlay::default())
+            tendril::fit::tune::load_tune(&path, &tendril_config::Overlay::default())
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             loaded.push(name);
         }

@@ -9,8 +9,8 @@
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
-use tendril::run::scenario::PickPlaceScenario;
-use tendril::scenario::ScenarioError;
+use tendril_config::ScenarioError;
+use tendril_run::scenario::PickPlaceScenario;
 
 mod common;
 use common::cli::{stderr, tendril_command};
@@ -166,7 +166,7 @@ enum Expect {
 
 /// Deserialises and validates a scenario table as the CLI does after `--set`.
 fn load_table(table: toml::Table, file: PathBuf) -> Result<(), ScenarioError> {
-    tendril::scenario::from_table::<PickPlaceScenario>(table, &file).map(|_| ())
+    tendril_config::from_table::<PickPlaceScenario>(table, &file).map(|_| ())
 }
 
 #[test]
@@ -260,8 +260,8 @@ fn set_arguments_and_raw_text_mutants_never_panic() {
             let what = format!("--set {arg}");
             let f = file.clone();
             let r = bounded(&what, move || {
-                let o: Result<tendril::scenario::Override, _> = arg.parse();
-                o.and_then(|o| tendril::scenario::load::<PickPlaceScenario>(&f, &[o]).map(|_| ()))
+                let o: Result<tendril_config::Override, _> = arg.parse();
+                o.and_then(|o| tendril_config::load::<PickPlaceScenario>(&f, &[o]).map(|_| ()))
             });
             assert!(r.is_err(), "{what}: accepted");
         } else {
@@ -278,7 +278,7 @@ fn set_arguments_and_raw_text_mutants_never_panic() {
             let path = dir.path().join(format!("mutant-{i}.toml"));
             std::fs::write(&path, &bytes).unwrap();
             let what = format!("text mutant {i}");
-            let _ = bounded(&what, move || tendril::scenario::load::<PickPlaceScenario>(&path, &[]).map(|_| ()));
+            let _ = bounded(&what, move || tendril_config::load::<PickPlaceScenario>(&path, &[]).map(|_| ()));
         }
     }
 }
@@ -338,7 +338,7 @@ fn sweep_mutants_are_refused_naming_the_sweep_file_and_never_hang() {
 /// A small but real bench record: the force calibration's bench with one short cycle.
 fn base_csv() -> String {
     let file = root().join("scenarios/bench-force-calibration.toml");
-    let o: Vec<tendril::scenario::Override> = [
+    let o: Vec<tendril_config::Override> = [
         "force_cycles.cycles=2",
         "force_cycles.load_time_s=1.0",
         "force_cycles.unload_time_s=1.0",
@@ -347,8 +347,8 @@ fn base_csv() -> String {
     .iter()
     .map(|s| s.parse().unwrap())
     .collect();
-    let s: tendril::sensor_bench::BenchScenario = tendril::scenario::load(&file, &o).unwrap();
-    tendril::sensor_bench::run(&s).to_csv()
+    let s: tendril_fbg::bench::BenchScenario = tendril_config::load(&file, &o).unwrap();
+    tendril_fbg::bench::run(&s).to_csv()
 }
 
 #[test]
@@ -358,7 +358,7 @@ fn bench_csv_mutants_are_refused_naming_the_line_and_never_spin() {
     let base = base_csv();
     let good = dir.path().join("good.csv");
     std::fs::write(&good, &base).unwrap();
-    assert!(tendril::calibration::report::calibrate_file(&good).is_ok(), "the base record calibrates");
+    assert!(tendril_fbg::calibration::report::calibrate_file(&good).is_ok(), "the base record calibrates");
     let lines: Vec<&str> = base.lines().collect();
     for i in 0..120 {
         let mut rows: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
@@ -399,7 +399,7 @@ fn bench_csv_mutants_are_refused_naming_the_line_and_never_spin() {
         std::fs::write(&path, rows.join("\n") + "\n").unwrap();
         let what = format!("CSV mutant {i} (kind {kind}, line {})", line + 1);
         let p = path.clone();
-        let r = bounded(&what, move || tendril::calibration::report::calibrate_file(&p).map_err(|e| e.to_string()));
+        let r = bounded(&what, move || tendril_fbg::calibration::report::calibrate_file(&p).map_err(|e| e.to_string()));
         if must_refuse {
             let err = r.expect_err(&what);
             assert!(err.contains(&format!("bench-{i}.csv")), "{what}: {err}");

@@ -6,8 +6,8 @@
 mod common;
 
 use common::short_lift;
-use tendril::control::task::Phase;
-use tendril::run::execute::run_on_twin;
+use tendril_control::task::Phase;
+use tendril_run::execute::run_on_twin;
 
 /// Cell time and true pad force \[N\] of the first grasp tick: where the close ended.
 fn close_end(noise_pm: f64, seed: u64) -> (f64, f64) {

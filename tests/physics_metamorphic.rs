@@ -8,8 +8,8 @@
 //! The steps between the compared settings are large (setpoint and friction well apart) because
 //! a no-feedback drop time scatters by a few tenths of a second between seeds.
 
-use tendril::scenario::Override;
 use tendril::study::{StudyRun, run_all, set};
+use tendril_config::Override;
 
 const SEEDS: [u64; 3] = [1, 2, 3];
 

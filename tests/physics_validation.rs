@@ -4,8 +4,8 @@
 
 use mujoco_rs::mujoco_c::_mjtObjBase::{mjOBJ_BODY, mjOBJ_GEOM};
 use mujoco_rs::prelude::MjModel;
-use tendril::cell::physics::validation::{self, ValidationRun};
-use tendril::cell::physics::{
+use tendril_twin::physics::validation::{self, ValidationRun};
+use tendril_twin::physics::{
     Backend, Integrator, ObjectConfig, ObjectName, Physics, PhysicsConfig, PhysicsError, Scene, SceneModel, SceneSpec,
 };
 
@@ -17,15 +17,15 @@ const G: f64 = 9.81;
 macro_rules! both_backends {
     ($($check:ident),* $(,)? ; rapier_open: $($open:ident),* $(,)?) => {
         mod mujoco {
-            $(#[test] fn $check() { super::$check(tendril::cell::physics::Backend::Mujoco) })*
-            $(#[test] fn $open() { super::$open(tendril::cell::physics::Backend::Mujoco) })*
+            $(#[test] fn $check() { super::$check(tendril_twin::physics::Backend::Mujoco) })*
+            $(#[test] fn $open() { super::$open(tendril_twin::physics::Backend::Mujoco) })*
         }
         mod rapier {
-            $(#[test] fn $check() { super::$check(tendril::cell::physics::Backend::Rapier) })*
+            $(#[test] fn $check() { super::$check(tendril_twin::physics::Backend::Rapier) })*
             $(
                 #[test]
                 #[ignore = "fails on rapier with the 32-link finger (README, The rapier backend)"]
-                fn $open() { super::$open(tendril::cell::physics::Backend::Rapier) }
+                fn $open() { super::$open(tendril_twin::physics::Backend::Rapier) }
             )*
         }
     };
@@ -199,7 +199,7 @@ fn more_twine_gives_more_grip_and_pad_force(backend: Backend) {
         s.run_for(3.5).unwrap();
         let n = (0.045 / WIND_M_S / s.timestep()).round() as usize;
         let every = (0.3 / s.timestep()).round() as usize;
-        let mut last: Option<tendril::cell::physics::PhysicsReadout> = None;
+        let mut last: Option<tendril_twin::physics::PhysicsReadout> = None;
         let mut first_pad = None;
         let mut curve = String::new();
         for k in 1..=n {
@@ -254,12 +254,12 @@ fn a_loose_grip_lets_the_object_slip_out(backend: Backend) {
     // Lift the hand 10 cm in 1 s with a twine that barely touches: the object stays behind.
     let mut s = grasp(&spec(backend), 0.008, 0.2).unwrap();
     let z0 = s.readout().object_in_hand_m[2];
-    let start = tendril::cell::physics::ur5e::forward(&tendril::cell::physics::ur5e::HOME);
-    let mut seed = tendril::cell::physics::ur5e::HOME;
+    let start = tendril_ur5e::kinematics::forward(&tendril_ur5e::kinematics::HOME);
+    let mut seed = tendril_ur5e::kinematics::HOME;
     for k in 1..=(1.0 / s.timestep()) as usize {
         let mut target = start;
         target.translation.vector.z += 0.1 * (k as f64 * s.timestep()).min(1.0);
-        seed = tendril::cell::physics::ur5e::inverse_near(&target, &seed).unwrap();
+        seed = tendril_ur5e::kinematics::inverse_near(&target, &seed).unwrap();
         s.set_arm_target(seed).unwrap();
         s.step().unwrap();
     }
@@ -375,13 +375,13 @@ fn bad_inputs_are_errors_not_nan(backend: Backend) {
 #[test]
 fn rapier_refuses_the_dynamic_arm_by_key() {
     let mut spec = spec(Backend::Rapier);
-    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Dynamic;
+    spec.physics.arm_mode = tendril_twin::physics::ArmMode::Dynamic;
     assert!(matches!(SceneModel::build(&spec), Err(PhysicsError::Config { key, .. }) if key == "physics.arm_mode"));
 }
 
 /// Distance between the readout's hand position and DH forward kinematics of `q` [m].
 fn hand_error_m(s: &dyn Physics, q: &[f64; 6]) -> f64 {
-    let fk = tendril::cell::physics::ur5e::forward(q).translation.vector;
+    let fk = tendril_ur5e::kinematics::forward(q).translation.vector;
     let hand = s.readout().hand_pos_m;
     ((hand[0] - fk.x).powi(2) + (hand[1] - fk.y).powi(2) + (hand[2] - fk.z).powi(2)).sqrt()
 }
@@ -394,7 +394,7 @@ const ARM_TARGET: [f64; 6] = [-1.5, -1.7, 1.8, -1.7, -1.57, 0.0];
 /// within 2 mm once settled.
 fn kinematic_arm_puts_the_hand_where_dh_kinematics_says(backend: Backend) {
     let mut spec = SceneSpec { object: None, arm_q0: ARM_START, ..spec(backend) };
-    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Kinematic;
+    spec.physics.arm_mode = tendril_twin::physics::ArmMode::Kinematic;
     let mut s = SceneModel::build(&spec).unwrap().start().unwrap();
     let at_start = if backend == Backend::Mujoco { 1e-9 } else { 1e-6 };
     let err = hand_error_m(s.as_ref(), &ARM_START);
@@ -409,7 +409,7 @@ fn kinematic_arm_puts_the_hand_where_dh_kinematics_says(backend: Backend) {
 #[test]
 fn dynamic_arm_puts_the_hand_where_dh_kinematics_says() {
     let mut spec = SceneSpec { object: None, arm_q0: ARM_START, ..SceneSpec::default() };
-    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Dynamic;
+    spec.physics.arm_mode = tendril_twin::physics::ArmMode::Dynamic;
     let mut s = Scene::build(&spec).unwrap();
     assert!(hand_error_m(&s, &ARM_START) < 1e-9);
     s.set_arm_target(ARM_TARGET).unwrap();
@@ -423,7 +423,7 @@ fn dynamic_arm_puts_the_hand_where_dh_kinematics_says() {
 #[test]
 fn dynamic_arm_holds_its_pose_under_the_payload() {
     let mut spec = SceneSpec { object: None, arm_q0: ARM_START, ..SceneSpec::default() };
-    spec.physics.arm_mode = tendril::cell::physics::ArmMode::Dynamic;
+    spec.physics.arm_mode = tendril_twin::physics::ArmMode::Dynamic;
     let mut s = Scene::build(&spec).unwrap();
     s.set_arm_target(ARM_START).unwrap();
     s.run_for(1.0).unwrap();

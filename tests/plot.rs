@@ -5,7 +5,7 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use tendril::plot;
+use tendril_plot as plot;
 
 fn workdir(name: &str) -> (Option<tempfile::TempDir>, PathBuf) {
     match std::env::var("TENDRIL_PLOT_DEMO") {

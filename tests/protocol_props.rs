@@ -2,12 +2,10 @@
 //! encode -> decode round-trips, and the Dynamixel stream resynchronises after garbage.
 
 use proptest::prelude::*;
-use tendril::cell::real::protocol::Decoded;
-use tendril::cell::real::protocol::dynamixel::{
-    self as dxl, InstructionPacket, RawPacket, StatusPacket, StreamDecoder, VirtualBus,
-};
-use tendril::cell::real::protocol::hyperion::{self, PeakFrame, PeakHeader, Request, Response, VirtualInterrogator};
-use tendril::cell::real::protocol::rtde::{
+use tendril_codec::Decoded;
+use tendril_dynamixel::{self as dxl, InstructionPacket, RawPacket, StatusPacket, StreamDecoder, VirtualBus};
+use tendril_hyperion::{self as hyperion, PeakFrame, PeakHeader, Request, Response, VirtualInterrogator};
+use tendril_rtde::{
     self, ClientPacket, ClientSession, Recipe, RtdeType, RtdeValue, ServerConfig, ServerPacket, ServerSession,
     SharedInputs,
 };
@@ -167,7 +165,7 @@ proptest! {
                 break;
             }
         }
-        let _ = server.poll_outputs(0.0, &rtde::RobotOutputs::default(), &shared);
+        let _ = server.poll_outputs(0.0, &tendril_rtde::RobotOutputs::default(), &shared);
     }
 
     #[test]
@@ -285,7 +283,7 @@ proptest! {
 
     #[test]
     fn dashboard_lines_parse_without_panicking(line in "\\PC{0,60}") {
-        use tendril::cell::real::protocol::dashboard::{Command, PolyscopeVersion, RobotMode, SafetyStatus};
+        use tendril_rtde::dashboard::{Command, PolyscopeVersion, RobotMode, SafetyStatus};
         let _ = Command::parse(&line).line();
         let _ = (RobotMode::parse_reply(&line), SafetyStatus::parse_reply(&line), PolyscopeVersion::parse_reply(&line));
     }
@@ -296,7 +294,7 @@ proptest! {
 /// A controller with nothing behind it: registers read 0, writes go nowhere.
 struct NullController;
 
-impl tendril::cell::real::urscript::Controller for NullController {
+impl tendril_urscript::Controller for NullController {
     fn input_int(&self, _: usize) -> i32 {
         0
     }
@@ -309,7 +307,7 @@ impl tendril::cell::real::urscript::Controller for NullController {
     fn set_output_int(&mut self, _: usize, _: i32) {}
     fn set_output_float(&mut self, _: usize, _: f64) {}
     fn set_output_bool(&mut self, _: usize, _: bool) {}
-    fn set_digital_out(&mut self, _: tendril::cell::real::urscript::DigitalOut, _: usize, _: bool) {}
+    fn set_digital_out(&mut self, _: tendril_urscript::DigitalOut, _: usize, _: bool) {}
     fn set_analog_out(&mut self, _: usize, _: f64) {}
     fn actual_q(&self) -> [f64; 6] {
         [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]
@@ -317,7 +315,7 @@ impl tendril::cell::real::urscript::Controller for NullController {
     fn input_packages(&self) -> u64 {
         0
     }
-    fn set_watchdog(&mut self, _: tendril::cell::real::urscript::RtdeWatchdog) {}
+    fn set_watchdog(&mut self, _: tendril_urscript::RtdeWatchdog) {}
     fn message(&mut self, _: &str) {}
 }
 
@@ -377,12 +375,12 @@ proptest! {
 
     #[test]
     fn urscript_never_panics_on_arbitrary_text(text in ".{0,300}") {
-        let _ = tendril::cell::real::urscript::Interpreter::new(&text, [0.0; 6]);
+        let _ = tendril_urscript::Interpreter::new(&text, [0.0; 6]);
     }
 
     #[test]
     fn urscript_programs_of_its_own_pieces_parse_or_fail_and_run_without_panicking(text in urscript_text()) {
-        if let Ok(mut p) = tendril::cell::real::urscript::Interpreter::new(&text, [0.0; 6]) {
+        if let Ok(mut p) = tendril_urscript::Interpreter::new(&text, [0.0; 6]) {
             for k in 0..20 {
                 let _ = p.step(k as f64 * 0.002, &mut NullController);
             }

@@ -10,7 +10,7 @@
 
 use std::net::{IpAddr, Ipv4Addr};
 use std::process::Command;
-use tendril::cell::real::serve::{ServeConfig, start};
+use tendril_serve::{ServeConfig, start};
 
 mod common;
 use common::{one_at_a_time, short_lift};
@@ -62,7 +62,7 @@ fn ur_rtde_reads_actual_q_matching_the_twin() {
     // the arm stands still.
     let q6: [f64; 6] = std::array::from_fn(|j| q[j]);
     let pose: Vec<f64> = serde_json::from_value(v["pose"].clone()).unwrap();
-    let expected = tendril::cell::real::serve::pose::tcp_pose(&q6, &[0.0; 6]);
+    let expected = tendril_ur5e::pose::tcp_pose(&q6, &[0.0; 6]);
     for (a, b) in pose.iter().zip(expected) {
         assert!((a - b).abs() < 1e-9, "ur_rtde pose {pose:?}, fk(q) {expected:?}");
     }
@@ -133,7 +133,7 @@ fn dynamixel_sdk_gets_the_manuals_status_errors_and_syncs_and_bulk_reads_the_mov
     assert!(twine_rad_matches(&twin, v["present"]["2"].as_i64().unwrap()), "{twin:?} {v}");
 }
 
-fn twine_rad_matches(twin: &tendril::cell::real::serve::TwinStatus, ticks: i64) -> bool {
+fn twine_rad_matches(twin: &tendril_serve::TwinStatus, ticks: i64) -> bool {
     (twin.motors_rad[1] - ticks as f64 * std::f64::consts::TAU / 4096.0).abs() < 0.05
 }
 
@@ -158,7 +158,7 @@ fn ur_rtde_dashboard_client_drives_the_virtual_dashboard_server() {
     assert_eq!(v["program_state"], "PLAYING /programs/follow.urp");
     assert_eq!(v["paused_state"], "PAUSED /programs/follow.urp");
     assert_eq!(v["running_after_stop"], false);
-    assert_eq!(program, tendril::cell::real::serve::ProgramState::Stopped);
+    assert_eq!(program, tendril_serve::ProgramState::Stopped);
 }
 
 fn close(a: &serde_json::Value, b: &serde_json::Value, tol: f64, what: &str) {
@@ -207,7 +207,7 @@ fn ur_rtde_control_interface_moves_the_twin_and_io_interface_sets_outputs() {
     // moveL 3 cm along x and 5 cm down: the TCP there within 1 mm, the orientation unchanged.
     let (got, want): (Vec<f64>, Vec<f64>) =
         (serde_json::from_value(v["after_movel"].clone()).unwrap(), serde_json::from_value(v["p1"].clone()).unwrap());
-    let to_pose = |p: &[f64]| tendril::cell::real::serve::pose::pose_from_vector(&std::array::from_fn(|k| p[k]));
+    let to_pose = |p: &[f64]| tendril_ur5e::pose::pose_from_vector(&std::array::from_fn(|k| p[k]));
     let (got, want) = (to_pose(&got), to_pose(&want));
     let off = (got.translation.vector - want.translation.vector).norm();
     assert!(off < 1e-3, "moveL ended {off} m from its target");

@@ -4,14 +4,14 @@
 //! within the tolerances of `common::phases`. `tests/serve_run_e2e.rs` does the same with the two
 //! binaries; here the twin's ground truth is at hand, and the devices' state after a stop.
 
-use tendril::cell::real::serve::jitter::Link;
-use tendril::cell::real::serve::{Jitter, JitterModel, ServeConfig, ServeHandle, start};
-use tendril::cell::real::{RealCell, RealCellConfig, Watchdog};
-use tendril::control::task::Phase;
-use tendril::hardware::Cell;
-use tendril::run::execute::run_on_twin;
-use tendril::run::real::run_on_real;
-use tendril::run::runner::Outcome;
+use tendril_cell::Cell;
+use tendril_control::task::Phase;
+use tendril_drivers::{RealCell, RealCellConfig, Watchdog};
+use tendril_run::execute::run_on_twin;
+use tendril_run::real::run_on_real;
+use tendril_run::runner::Outcome;
+use tendril_serve::jitter::Link;
+use tendril_serve::{Jitter, JitterModel, ServeConfig, ServeHandle, start};
 
 mod common;
 use common::{one_at_a_time, phases, short_lift};
@@ -25,7 +25,7 @@ fn real_path_against_virtual_devices_matches_the_twin() {
 
     let serve = start(&scenario, &ServeConfig::loopback().with_port_base(21710)).unwrap();
     // The default watchdogs, as a user's run has them.
-    let config = RealCellConfig::for_virtual_devices(&serve);
+    let config = serve.real_cell_config();
     // The real path has no ground truth; the twin behind the devices has. Sample its contact
     // flag through the run, to judge the outcome as the simulated path does: the object counts as
     // lost after 0.3 s without contact once grasped, while the arm carries it (from the release
@@ -89,7 +89,7 @@ fn the_comparison_catches_a_follow_program_that_shakes_the_grip_on_late_commands
     let stalls = JitterModel { stall_rate_hz: 4.0, stall_s: (0.02, 0.04), latency_median_s: 0.0, latency_sigma: 0.0 };
     devices.jitter = Some(Jitter { model: stalls, seed: 1, only: Some(Link::RtdeIn) });
     let serve = start(&scenario, &devices).unwrap();
-    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    let mut config = serve.real_cell_config();
     config.program = include_str!("fixtures/follow_by_arrival.script").into();
     let (_, real) = run_on_real(&scenario, config, None).unwrap();
     serve.stop().unwrap();
@@ -129,7 +129,7 @@ fn malformed_packets_close_the_connection_and_the_devices_keep_serving() {
     // HYPERION: an unknown command gets an error response, garbage closes the connection.
     let mut s = std::net::TcpStream::connect(serve.addrs[2]).unwrap();
     s.set_read_timeout(timeout).unwrap();
-    let req = tendril::cell::real::protocol::hyperion::Request::new("#NoSuchCommand", "").encode().unwrap();
+    let req = tendril_hyperion::Request::new("#NoSuchCommand", "").encode().unwrap();
     s.write_all(&req).unwrap();
     let n = s.read(&mut buf).unwrap();
     assert!(n >= 8 && buf[0] != 0, "expected an error status, got {:?}", &buf[..n]);
@@ -231,7 +231,7 @@ fn a_silent_gripper_bus_neither_holds_up_the_tick_nor_goes_unnoticed() {
 #[test]
 fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on() {
     let _turn = one_at_a_time();
-    use tendril::hardware::CellCommand;
+    use tendril_cell::CellCommand;
     let (serve, mut cell) = active_cell(|_| {});
     // Wind the twine motor for half a second, then stop as Ctrl-C does.
     for k in 1..=50 {
@@ -270,9 +270,9 @@ fn an_operator_stop_leaves_the_arm_stopped_and_the_motors_holding_with_torque_on
 #[test]
 fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
     let _turn = one_at_a_time();
-    use tendril::cell::real::HardwareConfig;
-    use tendril::cell::real::protocol::dynamixel::control_table::addr;
-    use tendril::hardware::CellCommand;
+    use tendril_cell::CellCommand;
+    use tendril_drivers::HardwareConfig;
+    use tendril_dynamixel::control_table::addr;
     let scenario = short_lift(&[
         "hardware.growth_id=11",
         "hardware.twine_id=12",
@@ -286,7 +286,7 @@ fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
         assert_eq!(s.bus.table(11).unwrap().read(addr::BAUD_RATE, 1).unwrap(), [3], "1 Mbit/s is Baud Rate 3");
     }
     // The real path with the same [hardware] finds both motors and both gratings on channel 3.
-    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    let mut config = serve.real_cell_config();
     assert_eq!(config.hardware, scenario.hardware);
     let mut cell = RealCell::new(config.clone());
     cell.configure().unwrap();
@@ -313,7 +313,7 @@ fn the_scenarios_motor_ids_bus_speed_and_fbg_channel_are_served_and_driven() {
 /// configuration adjusted by `tune`, configured and activated.
 fn active_cell(tune: impl FnOnce(&mut RealCellConfig)) -> (ServeHandle, RealCell) {
     let serve = start(&short_lift(&[]), &ServeConfig::ephemeral()).unwrap();
-    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    let mut config = serve.real_cell_config();
     tune(&mut config);
     let mut cell = RealCell::new(config);
     cell.configure().unwrap();

@@ -1,13 +1,12 @@
 //! The controllers beyond the paper's PID (`feedforward`, `slip_margin`) run on the real path as
 //! they do on the twin: the short grasp-hold-lift against the virtual devices (`tendril serve`'s
 //! devices, in-process, in real time), compared phase by phase with the same scenario on the
-//! simulated path within `tendril::run::compare`'s tolerances, with the default watchdogs.
+//! simulated path within `tendril_run::compare`'s tolerances, with the default watchdogs.
 
-use tendril::cell::real::RealCellConfig;
-use tendril::cell::real::serve::{ServeConfig, start};
-use tendril::run::execute::run_on_twin;
-use tendril::run::real::run_on_real;
-use tendril::run::runner::Outcome;
+use tendril_run::execute::run_on_twin;
+use tendril_run::real::run_on_real;
+use tendril_run::runner::Outcome;
+use tendril_serve::{ServeConfig, start};
 
 mod common;
 use common::{one_at_a_time, phases, short_lift};
@@ -22,7 +21,7 @@ fn feedforward_and_slip_margin_run_on_the_real_path_as_on_the_twin() {
         assert_eq!(sim.outcome, Outcome::Held, "{controller} on the twin: {:?}", sim.error);
 
         let serve = start(&scenario, &ServeConfig::loopback().with_port_base(port_base)).unwrap();
-        let config = RealCellConfig::for_virtual_devices(&serve);
+        let config = serve.real_cell_config();
         let (summary, real) = run_on_real(&scenario, config, None).unwrap();
         serve.stop().unwrap();
 

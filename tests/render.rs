@@ -10,7 +10,7 @@ use std::path::Path;
 
 mod common;
 use common::cli::{stderr, tendril};
-use tendril::render::frames::{FRAMES_FILE, FrameLog};
+use tendril_twin::frames::{FRAMES_FILE, FrameLog};
 
 const WIDTH: usize = 160;
 const HEIGHT: usize = 120;

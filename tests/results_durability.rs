@@ -3,10 +3,11 @@
 //! simulation (rows are written from a default summary), plus the writers on a full device.
 
 use std::path::{Path, PathBuf};
-use tendril::run::summary::RunSummary;
+use tendril::sweep::columns::{header, row, sweep_id};
 use tendril::sweep::durable::{ResultsError, ResultsFile, scan};
-use tendril::sweep::results::{header, merge, row, sweep_id};
+use tendril::sweep::results::merge;
 use tendril::sweep::{Sweep, load_sweep};
+use tendril_run::summary::RunSummary;
 
 /// A sweep of 12 runs (seeds 1-12, so ids reach two digits) over crimper.toml, written to `dir`.
 fn twelve_runs(dir: &Path, kp: f64) -> Sweep {
@@ -172,10 +173,10 @@ fn writers_on_a_full_device_report_the_error() {
         return;
     }
     // The trace: rows are buffered, so the failure shows at the latest on flush, and is kept.
-    let mut trace = tendril::run::trace::TraceWriter::create(full).unwrap();
-    let r = tendril::run::trace::TraceRow {
+    let mut trace = tendril_run::trace::TraceWriter::create(full).unwrap();
+    let r = tendril_run::trace::TraceRow {
         time_s: 0.0,
-        phase: tendril::control::task::Phase::Home,
+        phase: tendril_control::task::Phase::Home,
         true_force_n: 0.0,
         fbg1_nm: 1540.0,
         fbg2_nm: 1550.0,

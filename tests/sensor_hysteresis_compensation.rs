@@ -3,10 +3,10 @@
 //! compensation itself does (the shipped scenarios' 0.095 N load-cell noise dominates their RMSE).
 
 use std::path::Path;
-use tendril::calibration::{compare, fit_hysteresis_model, force_calibration};
-use tendril::control::estimate::ForceCalibration;
-use tendril::scenario::{Override, load};
-use tendril::sensor_bench::{BenchScenario, run};
+use tendril_config::{Override, load};
+use tendril_fbg::bench::{BenchScenario, run};
+use tendril_fbg::calibration::{compare, fit_hysteresis_model, force_calibration};
+use tendril_fbg::estimate::ForceCalibration;
 
 fn scenario(name: &str) -> BenchScenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(name);

@@ -1,9 +1,9 @@
 //! Forward model → estimator round trip over forces × temperatures (property tests).
 
 use proptest::prelude::*;
-use tendril::cell::fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
-use tendril::control::estimate::{ForceCalibration, ForceEstimator};
-use tendril::signals::Wavelengths;
+use tendril_fbg::estimate::{ForceCalibration, ForceEstimator};
+use tendril_fbg::signals::Wavelengths;
+use tendril_fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
 
 /// Mean of `n` samples at a held force and temperature (the lags settle first).
 fn settle_and_average(s: &mut FbgSensor, force: f64, temp: f64, n: usize) -> Wavelengths {

@@ -3,7 +3,7 @@
 //! (RTDE, URScript, HYPERION on loopback, the Dynamixel bus on the pty `serve` prints), and the
 //! simulated path `tendril run scenarios/short-lift.toml`. Both runs' `summary.json` must give
 //! the same outcome, and their `trace.csv` per-phase force percentiles and durations must agree
-//! within the tolerances of `tendril::run::compare` (which also says why the grasp's is looser),
+//! within the tolerances of `tendril_run::compare` (which also says why the grasp's is looser),
 //! with the default watchdogs, as a user runs it. About 16 s of wall time.
 //!
 //! Where the system allows it (root or CAP_SYS_NICE), both processes run their time-critical
@@ -109,7 +109,7 @@ fn serve(extra: &[&str]) -> (Server, u16, PathBuf) {
 /// may use SCHED_FIFO; else none.
 fn realtime_args() -> (Vec<&'static str>, Vec<&'static str>) {
     // On a short-lived thread, so this one keeps its scheduling.
-    let probe = std::thread::spawn(|| tendril::cell::real::realtime::set_realtime_priority(1).is_ok());
+    let probe = std::thread::spawn(|| tendril_drivers::realtime::set_realtime_priority(1).is_ok());
     if probe.join().unwrap_or(false) {
         (vec!["--rt-priority", "19"], vec!["--rt-priority", "20"])
     } else {

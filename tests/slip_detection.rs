@@ -5,9 +5,9 @@
 //! stays a finding, kept true here too.
 
 use std::path::Path;
-use tendril::run::execute::run_on_twin;
-use tendril::run::runner::RunReport;
-use tendril::run::summary::RunSummary;
+use tendril_run::execute::run_on_twin;
+use tendril_run::runner::RunReport;
+use tendril_run::summary::RunSummary;
 
 /// `scenarios/NAME.toml` with `overrides`, run on the twin (nothing written).
 fn run(name: &str, overrides: &[&str]) -> RunSummary {
@@ -17,8 +17,8 @@ fn run(name: &str, overrides: &[&str]) -> RunSummary {
 /// As [`run`], with the run's report (its rows).
 fn run_report(name: &str, overrides: &[&str]) -> (RunSummary, RunReport) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));
-    let overrides: Vec<tendril::scenario::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
-    let scenario = tendril::scenario::load(&path, &overrides).unwrap();
+    let overrides: Vec<tendril_config::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    let scenario = tendril_config::load(&path, &overrides).unwrap();
     run_on_twin(&scenario, &Default::default(), None).unwrap()
 }
 

@@ -159,44 +159,38 @@ fn under_xvfb_a_bounded_session_steps_and_saves_a_screenshot() {
     assert!(colours.len() > 50, "a blank picture: {} colours", colours.len());
 }
 
-/// The run loop's per-tick hook (what `tendril view` syncs through) sees every row, a hook that
-/// does nothing leaves the run as it was, and switching feedback off from it stops force control
+/// The session `tendril view` steps sees every tick, stepping it with the controller leaves the
+/// run as `run_task` makes it, and switching feedback off between ticks stops force control
 /// during the arm's moves.
 #[test]
-fn the_tick_hook_sees_every_tick_and_switches_feedback() {
-    use tendril::cell::physics::SceneModel;
-    use tendril::cell::sim::SimCell;
-    use tendril::control::task::Phase;
-    use tendril::run::runner::{run_task, run_task_observed};
+fn a_session_stepped_tick_by_tick_is_the_run_and_switches_feedback() {
+    use tendril_control::task::Phase;
+    use tendril_run::runner::run_task;
+    use tendril_run::session::{Action, Session};
+    use tendril_twin::physics::SceneModel;
 
     let scenario = common::short_lift(&["feedback=true"]);
     let plan = scenario.control_plan();
     let model = SceneModel::build(&scenario.scene_spec()).unwrap();
-    let plain = run_task(&mut SimCell::for_scenario(&scenario, model.clone()), &plan, None);
+    let plain = run_task(&mut scenario.sim_cell(model.clone()), &plan);
+    let mut session = Session::start(scenario.sim_cell(model.clone()), &plan, plan.controller.build(), None);
     let mut seen = 0;
-    let observed = run_task_observed(
-        &mut SimCell::for_scenario(&scenario, model.clone()),
-        &plan,
-        plan.controller.build(),
-        None,
-        &mut |_, _| seen += 1,
-    );
-    assert_eq!(seen, observed.rows.len());
-    assert_eq!(observed.rows, plain.rows, "a hook that does nothing changes nothing");
-    let moving = |rows: &[tendril::run::trace::TraceRow]| rows.iter().filter(|r| r.phase.arm_moving()).count();
+    while session.step(Action::Controller).is_some() {
+        seen += 1;
+    }
+    let (stepped, _) = session.finish();
+    assert_eq!(seen, stepped.rows.len());
+    assert_eq!(stepped.rows, plain.rows, "stepping tick by tick changes nothing");
+    let moving = |rows: &[tendril_run::trace::TraceRow]| rows.iter().filter(|r| r.phase.arm_moving()).count();
     assert!(moving(&plain.rows) > 10 && plain.rows.iter().any(|r| r.phase.arm_moving() && r.controller_on));
 
-    let switched = run_task_observed(
-        &mut SimCell::for_scenario(&scenario, model),
-        &plan,
-        plan.controller.build(),
-        None,
-        &mut |row, sequencer| {
-            if row.phase == Phase::Grasp {
-                sequencer.set_feedback(false);
-            }
-        },
-    );
+    let mut session = Session::start(scenario.sim_cell(model), &plan, plan.controller.build(), None);
+    while let Some(row) = session.step(Action::Controller) {
+        if row.phase == Phase::Grasp {
+            session.set_feedback(false);
+        }
+    }
+    let (switched, _) = session.finish();
     assert!(moving(&switched.rows) > 10);
     assert!(switched.rows.iter().filter(|r| r.phase.arm_moving()).all(|r| !r.controller_on), "feedback off");
 }

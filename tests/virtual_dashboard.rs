@@ -5,11 +5,11 @@
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
-use tendril::cell::real::protocol::dashboard::RobotMode;
-use tendril::cell::real::serve::{ProgramState, ServeConfig, ServeHandle, start};
-use tendril::cell::real::urscript::FOLLOW_SCRIPT;
-use tendril::cell::real::{RealCell, RealCellConfig};
-use tendril::hardware::Cell;
+use tendril_cell::Cell;
+use tendril_drivers::RealCell;
+use tendril_rtde::dashboard::RobotMode;
+use tendril_serve::{ProgramState, ServeConfig, ServeHandle, start};
+use tendril_urscript::FOLLOW_SCRIPT;
 
 mod common;
 use common::{one_at_a_time, short_lift};
@@ -123,9 +123,9 @@ fn the_dashboard_answers_as_the_controller_does_and_30003_takes_programs() {
 }
 
 /// The real path's configure against the virtual UR in `set`'s state: the error, if any.
-fn configure_error(serve: &ServeHandle, set: impl FnOnce(&mut tendril::cell::real::serve::DeviceState)) -> String {
+fn configure_error(serve: &ServeHandle, set: impl FnOnce(&mut tendril_serve::DeviceState)) -> String {
     set(&mut serve.state.lock().unwrap());
-    let mut cell = RealCell::new(RealCellConfig::for_virtual_devices(serve));
+    let mut cell = RealCell::new(serve.real_cell_config());
     let result = cell.configure();
     let _ = cell.deactivate();
     drop(cell);

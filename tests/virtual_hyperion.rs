@@ -5,9 +5,9 @@
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
-use tendril::cell::real::protocol::Decoded;
-use tendril::cell::real::protocol::hyperion::{PeakFrame, Request, Response, decode_stream_frame};
-use tendril::cell::real::serve::{ServeConfig, start};
+use tendril_codec::Decoded;
+use tendril_hyperion::{PeakFrame, Request, Response, decode_stream_frame};
+use tendril_serve::{ServeConfig, start};
 
 mod common;
 use common::{one_at_a_time, short_lift};

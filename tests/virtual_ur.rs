@@ -7,10 +7,10 @@ use std::collections::VecDeque;
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
-use tendril::cell::real::protocol::rtde::{ClientEvent, ClientPacket, ClientSession, RtdeValue};
-use tendril::cell::real::serve::pose::tcp_pose;
-use tendril::cell::real::serve::{ServeConfig, ServeHandle, start};
-use tendril::cell::real::urscript::{FOLLOW_SCRIPT, input_names};
+use tendril_rtde::{ClientEvent, ClientPacket, ClientSession, RtdeValue};
+use tendril_serve::{ServeConfig, ServeHandle, start};
+use tendril_ur5e::pose::tcp_pose;
+use tendril_urscript::{FOLLOW_SCRIPT, input_names};
 
 mod common;
 use common::{one_at_a_time, short_lift};

@@ -1,10 +1,10 @@
 //! `tendril chart`: studies over many runs, each written as CSV and charted.
 
 use super::emit;
-use crate::cell::physics::{Backend, FingerConfig, PhysicsConfig};
 use crate::study;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tendril_twin::physics::{Backend, FingerConfig, PhysicsConfig};
 
 /// Arguments of `tendril chart`.
 #[derive(Debug, clap::Args)]
@@ -42,7 +42,7 @@ pub struct ChartArgs {
     finest_step: Option<f64>,
     /// Convergence: override a scenario value in every run: `--set key.path=value` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<crate::scenario::Override>,
+    set: Vec<tendril_config::Override>,
 }
 
 /// The three objects' scenarios, or the ones given.
@@ -101,10 +101,10 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
 fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<PathBuf>, bool)> {
     use study::convergence::{CRITERIA, Case, FINEST_TIMESTEP_S, Plan, run};
     let mut extra = a.set.clone();
-    extra.extend(a.backend.map(crate::scenario::Override::backend));
+    extra.extend(a.backend.map(|b| b.as_override()));
     // The refinements start from the first scenario's own timestep and links (after --set).
     let scenarios = objects_or(&a.scenario);
-    let base: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&scenarios[0], &extra)?;
+    let base: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&scenarios[0], &extra)?;
     let (dt, links) = (base.physics.timestep_s, base.finger.segments);
     let finest = a.finest_step.unwrap_or(FINEST_TIMESTEP_S);
     // 1e-5 s: the scenario's own lower bound on `physics.timestep_s`.
@@ -149,8 +149,8 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
 /// `tendril chart controllers`: each controller × object × disturbance set × seed; prints the
 /// summary as markdown and whether a controller meets the goal. Returns the files written.
 fn controllers(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<Vec<PathBuf>> {
-    use crate::plot::controllers_summary::{GOAL_FLUCTUATION_PCT, controllers_meeting_goal, markdown};
     use study::controllers::{GOAL_SET, Plan, run};
+    use tendril_plot::controllers_summary::{GOAL_FLUCTUATION_PCT, controllers_meeting_goal, markdown};
     if let Some(seed) = a.seeds.iter().enumerate().find(|(i, s)| a.seeds[..*i].contains(s)).map(|(_, s)| s) {
         anyhow::bail!("--seeds: seed {seed} is given twice (each seed is one run per case)");
     }
@@ -161,7 +161,7 @@ fn controllers(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<Vec<PathB
     let started = std::time::Instant::now();
     let result = run(&plan, out, a.threads)?;
     emit(&markdown(&result.summary));
-    let objects = crate::plot::grid::first_seen(result.summary.iter().map(|r| r.object.as_str())).len();
+    let objects = tendril_plot::grid::first_seen(result.summary.iter().map(|r| r.object.as_str())).len();
     if plan.sets.iter().any(|s| s.name == GOAL_SET) {
         let meeting = controllers_meeting_goal(&result.summary, GOAL_SET);
         emit(&format!(

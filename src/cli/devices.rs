@@ -1,9 +1,9 @@
 //! Device options of `tendril run --hardware real`.
 
-use crate::cell::real::RealCellConfig;
-use crate::cell::real::realtime::RealtimeOptions;
-use crate::run::scenario::PickPlaceScenario;
-use crate::scenario::Override;
+use tendril_config::Override;
+use tendril_drivers::RealCellConfig;
+use tendril_drivers::realtime::RealtimeOptions;
+use tendril_run::scenario::PickPlaceScenario;
 
 /// Where the real (or virtual) devices are, how strict the watchdog is, how the control thread
 /// is scheduled. Motor IDs, bus speed and FBG windows are the scenario's `[hardware]`.
@@ -67,7 +67,7 @@ impl DeviceArgs {
         let w = &mut c.watchdog;
         for (flag, given, limit, least_ms) in [
             ("--sensor-stale-ms", self.sensor_stale_ms, &mut w.sensor_stale_s, c.sensor_period_s * 1e3),
-            ("--arm-stale-ms", self.arm_stale_ms, &mut w.arm_stale_s, 1e3 / crate::cell::real::ur::OUTPUT_RATE_HZ),
+            ("--arm-stale-ms", self.arm_stale_ms, &mut w.arm_stale_s, 1e3 / tendril_drivers::ur::OUTPUT_RATE_HZ),
             ("--motor-stale-ms", self.motor_stale_ms, &mut w.motor_stale_s, 1.0),
         ] {
             if let Some(ms) = given {

@@ -36,14 +36,14 @@ pub struct FitArgs {
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let mut fit = crate::fit::load_fit(&a.fit)?;
-    fit.start_from(&crate::scenario::Overlay::load(a.start.as_deref())?)?;
+    fit.start_from(&tendril_config::Overlay::load(a.start.as_deref())?)?;
     if let Some(n) = a.evaluations {
         fit.budget.evaluations = n as usize;
         fit.budget.prescreen = fit.budget.prescreen.min(n as usize - 1);
     }
     let stem = a.fit.file_stem().map_or("fit".into(), |s| s.to_string_lossy().to_string());
     let out_dir = a.out.unwrap_or_else(|| PathBuf::from("out").join(format!("fit-{stem}")));
-    crate::interrupt::install()?;
+    crate::signals::install_signal_handlers()?;
     let options = FitOptions { out_dir, threads: a.threads.filter(|&n| n > 0), resume: a.resume };
     let (report, written) = run_fit(&fit, &options)?;
     let mut text = format!(
@@ -91,10 +91,10 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     }
     text += &format!("wrote {}\n", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     emit(&text);
-    if let Some(signal) = crate::interrupt::requested() {
+    if let Some(signal) = tendril_cell::interrupt::requested() {
         emit(&format!(
             "stopped by {}: every finished evaluation is in the log; --resume continues\n",
-            crate::interrupt::name(signal)
+            tendril_cell::interrupt::name(signal)
         ));
     }
     Ok(super::exit_for_runs(false))

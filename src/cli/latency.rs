@@ -1,13 +1,13 @@
 //! `tendril latency`: the real path against the virtual devices on loopback, at 500 Hz.
 
 use super::emit;
-use crate::cell::real::latency::{LatencyReport, measure, measure_idle};
-use crate::cell::real::realtime::RealtimeOptions;
-use crate::cell::real::serve::{ServeConfig, start};
-use crate::cell::real::{RealCell, RealCellConfig};
-use crate::run::scenario::PickPlaceScenario;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tendril_drivers::RealCell;
+use tendril_drivers::latency::{LatencyReport, measure, measure_idle};
+use tendril_drivers::realtime::RealtimeOptions;
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_serve::{ServeConfig, start};
 
 /// Arguments of `tendril latency`.
 #[derive(Debug, clap::Args)]
@@ -57,7 +57,7 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
         "--stale-ms must be 2-10000 (one RTDE period to 10 s), got {}",
         a.stale_ms
     );
-    let scenario: PickPlaceScenario = crate::scenario::load(&a.scenario, &[])?;
+    let scenario: PickPlaceScenario = tendril_config::load(&a.scenario, &[])?;
     let control = a.realtime.options()?;
     let label = format!("{} Hz for {} s", a.rate_hz, a.seconds);
     let floor = if a.floor {
@@ -79,9 +79,9 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
         lock_memory: control.lock_memory,
     };
     let serve = start(&scenario, &serve_config)?;
-    let mut config = RealCellConfig::for_virtual_devices(&serve);
+    let mut config = serve.real_cell_config();
     config.sensor_period_s = 1.0 / scenario.interrogator.sample_rate_hz;
-    config.watchdog = crate::cell::real::Watchdog::uniform(a.stale_ms * 1e-3);
+    config.watchdog = tendril_drivers::Watchdog::uniform(a.stale_ms * 1e-3);
     // After the devices started, so that they do not inherit the control thread's CPU.
     control.apply_to_current_thread()?;
     let mut cell = RealCell::new(config);

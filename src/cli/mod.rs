@@ -81,7 +81,7 @@ enum Command {
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
 pub fn main() -> ExitCode {
     // SAFETY: first thing, before any thread exists that could use MuJoCo.
-    unsafe { crate::mujoco_log::install() };
+    unsafe { tendril_twin::mujoco_log::install() };
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Reproduce(a) => reproduce::run(a),
@@ -140,7 +140,7 @@ fn emit(text: &str) {
 /// Writes `text` to `path` atomically (a failure keeps the previous file), naming the file in the
 /// error.
 fn write_file(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
-    crate::run::output::write_atomically(path, text.as_bytes())
+    tendril_config::write_atomically(path, text.as_bytes())
         .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
 }
 
@@ -164,8 +164,8 @@ pub const EXIT_RUN_ERROR: u8 = 3;
 /// The exit code of a command that ran scenarios: `128 + signal` if an operator stop ended it,
 /// [`EXIT_RUN_ERROR`] if a run ended in error, else success.
 fn exit_for_runs(any_error: bool) -> ExitCode {
-    match crate::interrupt::requested() {
-        Some(signal) => ExitCode::from(crate::interrupt::exit_code(signal)),
+    match tendril_cell::interrupt::requested() {
+        Some(signal) => ExitCode::from(tendril_cell::interrupt::exit_code(signal)),
         None if any_error => ExitCode::from(EXIT_RUN_ERROR),
         None => ExitCode::SUCCESS,
     }

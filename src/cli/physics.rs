@@ -1,9 +1,9 @@
 //! `tendril physics-check`.
 
-use crate::cell::physics::check::CheckScenario;
-use crate::scenario::Override;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use tendril_config::Override;
+use tendril_twin::physics::check::CheckScenario;
 
 /// Arguments of `tendril physics-check`.
 #[derive(Debug, clap::Args)]
@@ -17,10 +17,10 @@ pub struct PhysicsCheckArgs {
 
 pub fn run(a: PhysicsCheckArgs) -> anyhow::Result<ExitCode> {
     let s: CheckScenario = match a.scenario {
-        Some(path) => crate::scenario::load(&path, &a.set)?,
-        None => crate::scenario::from_str("", Path::new("(defaults)"), &a.set)?,
+        Some(path) => tendril_config::load(&path, &a.set)?,
+        None => tendril_config::from_str("", Path::new("(defaults)"), &a.set)?,
     };
-    crate::cell::physics::check::run(&s)?;
+    tendril_twin::physics::check::run(&s)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -46,9 +46,9 @@ pub struct SceneArgs {
 pub fn scene(a: SceneArgs) -> anyhow::Result<ExitCode> {
     let mut overrides = a.set.clone();
     overrides.extend(a.models.as_deref().map(Override::models_dir));
-    let s: crate::run::scenario::PickPlaceScenario = crate::scenario::load(&a.scenario, &overrides)?;
-    let model = crate::cell::physics::SceneModel::build(&s.scene_spec())?;
-    let xml = crate::cell::physics::export::standalone_xml(&model)?;
+    let s: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&a.scenario, &overrides)?;
+    let model = tendril_twin::physics::SceneModel::build(&s.scene_spec())?;
+    let xml = tendril_twin::physics::export::standalone_xml(&model)?;
     std::fs::write(&a.out, xml).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", a.out.display()))?;
     super::emit(&format!(
         "wrote {} (keyframe `start`: python -m mujoco.viewer --mjcf {})\n",

@@ -15,7 +15,7 @@ pub struct PlotArgs {
 }
 
 pub fn run(a: PlotArgs) -> anyhow::Result<ExitCode> {
-    for file in crate::plot::plot_path(&a.path, a.out.as_deref())? {
+    for file in tendril_plot::plot_path(&a.path, a.out.as_deref())? {
         emit(&format!("{}\n", file.display()));
     }
     Ok(ExitCode::SUCCESS)

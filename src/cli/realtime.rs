@@ -1,7 +1,7 @@
 //! Scheduling options of the time-critical threads: the control thread of `tendril run --hardware
 //! real` and `tendril latency`, the virtual devices' threads of `tendril serve`.
 
-use crate::cell::real::realtime::RealtimeOptions;
+use tendril_drivers::realtime::RealtimeOptions;
 
 /// How the time-critical threads are scheduled (default: as any other thread).
 #[derive(Debug, Clone, clap::Args)]

@@ -2,9 +2,9 @@
 
 use super::{emit, exit_all, write_file};
 use crate::reproduce::{Row, render_table};
-use crate::scenario::Override;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use tendril_config::Override;
 
 /// Arguments of `tendril reproduce`.
 #[derive(Debug, clap::Args)]
@@ -19,7 +19,7 @@ pub struct ReproduceArgs {
     scenarios: PathBuf,
     /// The twin's physics engine for Sec. V, `mujoco` or `rapier` (default: the scenarios' own).
     #[arg(long)]
-    backend: Option<crate::cell::physics::Backend>,
+    backend: Option<tendril_twin::physics::Backend>,
     /// Scenario keys from a file (what `tendril fit` and `tendril tune` write), applied to the Sec. V
     /// scenarios after each file and before `--set`.
     #[arg(long)]
@@ -30,13 +30,13 @@ pub struct ReproduceArgs {
 }
 
 pub fn run(a: ReproduceArgs) -> anyhow::Result<ExitCode> {
-    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let overlay = tendril_config::Overlay::load(a.overlay.as_deref())?;
     let mut set = a.set.clone();
-    set.extend(a.backend.map(Override::backend));
+    set.extend(a.backend.map(|b| b.as_override()));
     let overrides = overlay.then(&set);
     // A bad overlay value is reported against the overlay, as on every other command.
     let rows = reproduce_rows(&a.what, &a.scenarios, &overrides).map_err(|e| {
-        match e.downcast::<crate::scenario::ScenarioError>() {
+        match e.downcast::<tendril_config::ScenarioError>() {
             Ok(e) => anyhow::Error::from(overlay.attribute(e, &set)),
             Err(e) => e,
         }

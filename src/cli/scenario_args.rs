@@ -1,9 +1,9 @@
 //! The arguments that pick and adjust a scenario, shared by the commands that run one on the
 //! twin (`tendril run`, `tendril view`).
 
-use crate::run::scenario::PickPlaceScenario;
-use crate::scenario::Override;
 use std::path::PathBuf;
+use tendril_config::Override;
+use tendril_run::scenario::PickPlaceScenario;
 
 /// A scenario file and what the command line changes in it.
 #[derive(Debug, clap::Args)]
@@ -36,7 +36,7 @@ impl ScenarioArgs {
         let mut o = self.set.clone();
         o.extend(extra);
         if let Some(seed) = self.seed {
-            o.push(Override { key: "seed".into(), value: crate::scenario::seed::to_toml(seed) });
+            o.push(Override { key: "seed".into(), value: tendril_config::seed::to_toml(seed) });
         }
         if let Some(f) = &self.feedback {
             o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(f == "on") });
@@ -47,7 +47,7 @@ impl ScenarioArgs {
 
     /// The scenario with the overlay and the overrides applied, validated.
     pub fn load(&self, extra: impl IntoIterator<Item = Override>) -> anyhow::Result<PickPlaceScenario> {
-        let overlay = crate::scenario::Overlay::load(self.overlay.as_deref())?;
+        let overlay = tendril_config::Overlay::load(self.overlay.as_deref())?;
         Ok(overlay.load_scenario(&self.scenario, &self.overrides(extra))?)
     }
 }

@@ -1,10 +1,10 @@
 //! `tendril calibrate` and `tendril bench`: the sensor bench.
 
 use super::{emit, write_file};
-use crate::scenario::Override;
-use crate::sensor_bench::BenchScenario;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tendril_config::Override;
+use tendril_fbg::bench::BenchScenario;
 
 /// Arguments of `tendril calibrate`.
 #[derive(Debug, clap::Args)]
@@ -27,13 +27,13 @@ pub struct BenchArgs {
 }
 
 pub fn calibrate(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
-    emit(&crate::calibration::report::calibrate_file(&a.file)?);
+    emit(&tendril_fbg::calibration::report::calibrate_file(&a.file)?);
     Ok(ExitCode::SUCCESS)
 }
 
 pub fn bench(a: BenchArgs) -> anyhow::Result<ExitCode> {
-    let s: BenchScenario = crate::scenario::load(&a.scenario, &a.set)?;
-    let csv = crate::sensor_bench::run(&s).to_csv();
+    let s: BenchScenario = tendril_config::load(&a.scenario, &a.set)?;
+    let csv = tendril_fbg::bench::run(&s).to_csv();
     match a.out {
         Some(path) => write_file(&path, &csv)?,
         None => emit(&csv),

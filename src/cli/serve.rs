@@ -1,14 +1,14 @@
 //! `tendril serve`: the twin behind the real devices' protocols.
 
 use super::emit;
-use crate::cell::real::serve::jitter::Link;
-use crate::cell::real::serve::{Jitter, JitterProfile, ProgramState, ServeConfig, start};
-use crate::run::scenario::PickPlaceScenario;
-use crate::scenario::Override;
 use std::net::IpAddr;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
+use tendril_config::Override;
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_serve::jitter::Link;
+use tendril_serve::{Jitter, JitterProfile, ProgramState, ServeConfig, start};
 
 /// Arguments of `tendril serve`.
 #[derive(Debug, clap::Args)]
@@ -49,7 +49,7 @@ pub struct ServeArgs {
 }
 
 pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
-    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let overlay = tendril_config::Overlay::load(a.overlay.as_deref())?;
     let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.set)?;
     let mut config = ServeConfig::loopback();
     config.bind = a.bind;
@@ -79,11 +79,11 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
         ));
     }
     // Ctrl-C, SIGTERM and SIGHUP alike: the devices are shut down and the status reported.
-    crate::interrupt::install()?;
+    crate::signals::install_signal_handlers()?;
     let started = std::time::Instant::now();
     // What the virtual UR5e's program and safety system last did, to report their changes.
     let mut reported = (ProgramState::Stopped, None::<String>);
-    while crate::interrupt::requested().is_none() && handle.running() {
+    while tendril_cell::interrupt::requested().is_none() && handle.running() {
         if a.seconds.is_some_and(|s| started.elapsed().as_secs_f64() >= s) {
             break;
         }

@@ -60,7 +60,7 @@ pub struct MergeArgs {
 
 pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
     let mut sweep = load_sweep(&a.sweep)?;
-    sweep.overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    sweep.overlay = tendril_config::Overlay::load(a.overlay.as_deref())?;
     let stem = a.sweep.file_stem().map_or("sweep".into(), |s| s.to_string_lossy().to_string());
     let options = SweepOptions {
         out_dir: a.out.unwrap_or_else(|| PathBuf::from("out").join(stem)),
@@ -69,13 +69,17 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         resume: a.resume,
     };
     // Ctrl-C, SIGTERM and SIGHUP: no new run starts; every finished row is kept whole.
-    crate::interrupt::install()?;
+    crate::signals::install_signal_handlers()?;
     let stats = run_sweep(&sweep, &options)?;
     if let Some(bytes) = stats.dropped_tail {
         emit(&format!("{}: cut off a torn last row ({bytes} bytes); its run is run again\n", stats.results.display()));
     }
-    if let Some(signal) = crate::interrupt::requested() {
-        emit(&format!("stopped by {}: {} runs finished and written\n", crate::interrupt::name(signal), stats.ran));
+    if let Some(signal) = tendril_cell::interrupt::requested() {
+        emit(&format!(
+            "stopped by {}: {} runs finished and written\n",
+            tendril_cell::interrupt::name(signal),
+            stats.ran
+        ));
     }
     emit(&format!(
         "{} runs in this sweep{}: {} run now ({} errors), {} already done; {:.0} simulated s in {:.1} s wall ({}x real time)\nwrote {}\n",
@@ -86,7 +90,7 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         stats.skipped,
         stats.sim_time_s,
         stats.wall_time_s,
-        crate::run::summary::speed_factor(stats.sim_time_s / stats.wall_time_s.max(1e-9)),
+        tendril_run::summary::speed_factor(stats.sim_time_s / stats.wall_time_s.max(1e-9)),
         stats.results.display()
     ));
     Ok(super::exit_for_runs(stats.errors > 0))

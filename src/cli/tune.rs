@@ -27,11 +27,11 @@ pub struct TuneArgs {
 }
 
 pub fn run(a: TuneArgs) -> anyhow::Result<ExitCode> {
-    let overlay = crate::scenario::Overlay::load(a.overlay.as_deref())?;
+    let overlay = tendril_config::Overlay::load(a.overlay.as_deref())?;
     let tune = load_tune(&a.tune, &overlay)?;
     let stem = a.tune.file_stem().map_or("tune".into(), |s| s.to_string_lossy().to_string());
     let out_dir = a.out.unwrap_or_else(|| PathBuf::from("out").join(format!("tune-{stem}")));
-    crate::interrupt::install()?;
+    crate::signals::install_signal_handlers()?;
     let (results, written) = run_tune(&tune, &out_dir, a.threads.filter(|&n| n > 0), a.resume)?;
     let mut text = String::new();
     let mut scenarios: Vec<&str> = results.iter().map(|r| r.scenario.as_str()).collect();
@@ -66,10 +66,10 @@ pub fn run(a: TuneArgs) -> anyhow::Result<ExitCode> {
     }
     text += &format!("wrote {}\n", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     emit(&text);
-    if let Some(signal) = crate::interrupt::requested() {
+    if let Some(signal) = tendril_cell::interrupt::requested() {
         emit(&format!(
             "stopped by {}: every finished evaluation is in the logs; --resume continues\n",
-            crate::interrupt::name(signal)
+            tendril_cell::interrupt::name(signal)
         ));
     }
     Ok(super::exit_for_runs(false))

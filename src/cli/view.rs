@@ -1,9 +1,9 @@
 //! `tendril view`.
 
-use crate::run::scenario::PickPlaceScenario;
 use crate::view::{ViewOptions, view};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tendril_run::scenario::PickPlaceScenario;
 
 /// Arguments of `tendril view`.
 #[derive(Debug, clap::Args)]
@@ -37,7 +37,7 @@ fn speed_arg(s: &str) -> Result<f64, String> {
 pub fn run(a: ViewArgs) -> anyhow::Result<ExitCode> {
     let scenario: PickPlaceScenario = a.scenario.load([])?;
     // Ctrl-C, SIGTERM and SIGHUP: the run's safe stop, then the window closes.
-    crate::interrupt::install()?;
+    crate::signals::install_signal_handlers()?;
     let opts = ViewOptions { speed: a.speed, seconds: a.seconds, screenshot: a.screenshot.clone() };
     let report = view(&scenario, &opts)?;
     let shot = opts.screenshot.as_ref().map_or(String::new(), |p| format!("; wrote {}", p.display()));

@@ -9,14 +9,14 @@ use super::optimizer::{Evaluation, FAILED, SearchResult, minimize};
 use super::recording::{Events, Recording};
 use super::spec::Fit;
 use super::target::{Target, TargetResidual};
-use crate::run::execute::{ModelCache, run_on_twin};
-use crate::run::runner::RunReport;
-use crate::run::scenario::PickPlaceScenario;
-use crate::run::summary::RunSummary;
-use crate::scenario::Override;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use tendril_config::Override;
+use tendril_run::execute::{ModelCache, run_on_twin};
+use tendril_run::runner::RunReport;
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::summary::RunSummary;
 
 /// Name of the evaluations log in a fit's or tune's output folder.
 pub const LOG_FILE: &str = "evaluations.jsonl";
@@ -25,8 +25,8 @@ pub const LOG_FILE: &str = "evaluations.jsonl";
 /// only used in messages.
 pub fn simulate(base: &toml::Table, file: &Path, overrides: &[Override]) -> anyhow::Result<(RunSummary, RunReport)> {
     let mut table = base.clone();
-    crate::scenario::apply_overrides(&mut table, overrides)?;
-    let scenario: PickPlaceScenario = crate::scenario::from_table(table, file)?;
+    tendril_config::apply_overrides(&mut table, overrides)?;
+    let scenario: PickPlaceScenario = tendril_config::from_table(table, file)?;
     // A model per run: candidates differ in the scene's parameters, so nothing would be shared.
     run_on_twin(&scenario, &ModelCache::default(), None)
 }
@@ -253,7 +253,7 @@ fn write_results(
 ) -> anyhow::Result<(FitReport, Vec<PathBuf>)> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build()?;
     // Stopped by a signal: the best candidate's residuals as logged (a replay would be cut short).
-    let replays = if crate::interrupt::requested().is_some() {
+    let replays = if tendril_cell::interrupt::requested().is_some() {
         let logged = |key: &str| result.best_record.as_ref().map(|r| r.detail[key].clone());
         let recordings: Vec<Residual> =
             logged("residuals").and_then(|v| serde_json::from_value(v).ok()).unwrap_or_default();
@@ -310,19 +310,19 @@ fn write_results(
     let fitted = |rep: &Option<RunReport>| {
         rep.as_ref().map_or_else(Vec::new, |rep| rep.rows.iter().map(|t| (t.time_s, t.force_n)).collect())
     };
-    let chart = crate::plot::fit::FitChart {
+    let chart = tendril_plot::fit::FitChart {
         title: format!("tendril fit {}", fit.file.display()),
         traces: fit
             .recordings
             .iter()
             .zip(replays.recordings.iter().chain(std::iter::repeat(&empty)))
-            .map(|(r, (res, rep))| crate::plot::fit::TracePair {
+            .map(|(r, (res, rep))| tendril_plot::fit::TracePair {
                 name: format!("{} (RMSE {})", r.name, res.force_rmse_n.map_or("-".into(), |v| format!("{v:.3} N"))),
                 recorded: r.ticks.iter().map(|t| (t.time_s, t.force_n)).collect(),
                 fitted: fitted(rep),
             })
             // A target has figures, not a trace: its panel shows the fitted run alone.
-            .chain(replays.targets.iter().map(|(t, rep)| crate::plot::fit::TracePair {
+            .chain(replays.targets.iter().map(|(t, rep)| tendril_plot::fit::TracePair {
                 name: format!("{} ({}, score {:.3})", t.target, t.outcome, t.score),
                 recorded: Vec::new(),
                 fitted: fitted(rep),
@@ -330,6 +330,6 @@ fn write_results(
             .collect(),
         objective: result.history.iter().map(|r| (r.index, r.exact_objective().unwrap_or(FAILED), r.failed)).collect(),
     };
-    written.extend(crate::plot::save(&chart, out_dir, "fit")?);
+    written.extend(tendril_plot::save(&chart, out_dir, "fit")?);
     Ok((report, written))
 }

@@ -27,7 +27,7 @@ use std::path::Path;
 
 /// Writes `path` atomically, naming it in the error.
 pub fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
-    crate::run::output::write_atomically(path, text.as_bytes())
+    tendril_config::write_atomically(path, text.as_bytes())
         .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
 }
 

@@ -16,8 +16,8 @@
 //!   little.
 
 use super::recording::{Events, Tick};
-use crate::run::trace::TraceRow;
 use serde::{Deserialize, Serialize};
+use tendril_run::trace::TraceRow;
 
 /// The weights of the objective's terms (`[objective]` in FIT.toml).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -168,9 +168,9 @@ pub fn trace_rmse(
 }
 
 /// Centred moving average over `window` samples (shorter at the ends), the calibration's
-/// [`smooth`](crate::calibration::smooth) over `window / 2` each side; `window` ≤ 1 copies.
+/// [`smooth`](tendril_fbg::calibration::smooth) over `window / 2` each side; `window` ≤ 1 copies.
 fn moving_average(x: &[f64], window: usize) -> Vec<f64> {
-    if window <= 1 { x.to_vec() } else { crate::calibration::smooth(x, window / 2) }
+    if window <= 1 { x.to_vec() } else { tendril_fbg::calibration::smooth(x, window / 2) }
 }
 
 /// Compares a simulated run (`rows`, `events`) with a recording (`ticks`, `recorded`).
@@ -227,7 +227,7 @@ pub fn compare(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::control::task::Phase;
+    use tendril_control::task::Phase;
 
     fn row(t: f64, f: f64) -> TraceRow {
         TraceRow::at(t, Phase::Grasp, f)

@@ -151,14 +151,14 @@ where
         if let Some(r) = cache.lock().unwrap_or_else(|p| p.into_inner()).get(&key) {
             return r.exact_objective().unwrap_or(FAILED) + outside;
         }
-        let stopping =
-            crate::interrupt::requested().is_some() || write_error.lock().unwrap_or_else(|p| p.into_inner()).is_some();
+        let stopping = tendril_cell::interrupt::requested().is_some()
+            || write_error.lock().unwrap_or_else(|p| p.into_inner()).is_some();
         // Beyond the budget (the last generation's remainder) or stopping: not run, not logged.
         if stopping || used.fetch_add(1, SeqCst) >= budget.evaluations {
             return FAILED + outside;
         }
         let e = evaluate(&values);
-        if crate::interrupt::requested().is_some() {
+        if tendril_cell::interrupt::requested().is_some() {
             // Cut short by the stop: not a result, run again on --resume.
             return FAILED + outside;
         }
@@ -217,7 +217,7 @@ where
         }
         loop {
             let end = cmaes.next_parallel();
-            if crate::interrupt::requested().is_some() {
+            if tendril_cell::interrupt::requested().is_some() {
                 break "stopped by a signal".to_string();
             }
             if write_error.lock().unwrap_or_else(|p| p.into_inner()).is_some() {

@@ -1,8 +1,8 @@
 //! A recording: a run directory as `tendril run --out` writes it (`trace.csv` and `summary.json`
 //! with the effective scenario), made by the twin or by the real cell.
 
-use crate::run::scenario::PickPlaceScenario;
 use std::path::{Path, PathBuf};
+use tendril_run::scenario::PickPlaceScenario;
 
 /// Columns `trace.csv` must have, as `tendril run` writes them (the order may differ).
 pub const REQUIRED_COLUMNS: [&str; 4] = ["time_s", "phase", "force_n", "twine_motor_rad"];
@@ -47,7 +47,7 @@ pub struct Events {
 
 impl Events {
     /// The events of a run's summary.
-    pub fn of(s: &crate::run::summary::RunSummary) -> Events {
+    pub fn of(s: &tendril_run::summary::RunSummary) -> Events {
         Events {
             outcome: s.outcome.clone(),
             drop_cell_time_s: s.drop_cell_time_s,
@@ -92,7 +92,7 @@ impl Recording {
         let effective = json.as_object_mut().and_then(|o| o.remove("effective_scenario")).ok_or_else(|| {
             err(summary_path.clone(), "no `effective_scenario`: not a summary `tendril run` wrote".into())
         })?;
-        let summary: crate::run::summary::RunSummary =
+        let summary: tendril_run::summary::RunSummary =
             serde_json::from_value(json).map_err(|e| err(summary_path.clone(), format!("not a run summary: {e}")))?;
         let scenario: PickPlaceScenario = serde_json::from_value(effective)
             .map_err(|e| err(summary_path.clone(), format!("`effective_scenario`: {e}")))?;
@@ -101,7 +101,7 @@ impl Recording {
             _ => return Err(err(summary_path.clone(), "`effective_scenario` cannot be written as TOML".into())),
         };
         // The effective scenario must itself be valid (a hand-edited summary may not be).
-        let scenario: PickPlaceScenario = crate::scenario::from_table(table.clone(), &summary_path)
+        let scenario: PickPlaceScenario = tendril_config::from_table(table.clone(), &summary_path)
             .map_err(|e| err(summary_path.clone(), format!("`effective_scenario`: {e}")))?;
         let mismatch = |what: &str, recorded: String, effective: String| {
             err(
@@ -129,7 +129,7 @@ impl Recording {
 /// Reads the ticks of `trace.csv`, checking its columns and that its ticks are `1 / rate_hz` apart.
 fn read_trace(path: &Path, rate_hz: f64) -> Result<Vec<Tick>, RecordingError> {
     let err = |reason: String| RecordingError { file: path.into(), reason };
-    let table = crate::plot::input::Table::read(path).map_err(|e| err(e.to_string()))?;
+    let table = tendril_plot::input::Table::read(path).map_err(|e| err(e.to_string()))?;
     let mut cols = [0usize; 4];
     for (c, name) in cols.iter_mut().zip(REQUIRED_COLUMNS) {
         *c = table.header.iter().position(|h| h == name).ok_or_else(|| {

@@ -104,8 +104,8 @@ impl Parameter {
     }
 
     /// The `--set` override that puts `v` at this key (its scenario key, without a scope).
-    pub fn override_at(&self, v: f64) -> crate::scenario::Override {
-        crate::scenario::Override { key: self.scenario_key().into(), value: self.toml_value(v) }
+    pub fn override_at(&self, v: f64) -> tendril_config::Override {
+        tendril_config::Override { key: self.scenario_key().into(), value: self.toml_value(v) }
     }
 
     /// The scope of a key written `NAME:KEY` (a fit's target or recording name), which the
@@ -135,9 +135,9 @@ pub fn same_point(a: &[f64], b: &[f64]) -> bool {
 pub fn parameters(
     file: &std::path::Path,
     specs: &std::collections::BTreeMap<String, ParameterSpec>,
-) -> Result<Vec<Parameter>, crate::scenario::ScenarioError> {
+) -> Result<Vec<Parameter>, tendril_config::ScenarioError> {
     if specs.is_empty() {
-        return Err(crate::scenario::ScenarioError::Invalid {
+        return Err(tendril_config::ScenarioError::Invalid {
             file: file.into(),
             key: "parameters".into(),
             reason: "names no parameter: add a [parameters.\"KEY\"] table with min and max".into(),
@@ -146,7 +146,7 @@ pub fn parameters(
     specs
         .iter()
         .map(|(key, spec)| {
-            Parameter::from_spec(key, spec).map_err(|reason| crate::scenario::ScenarioError::Invalid {
+            Parameter::from_spec(key, spec).map_err(|reason| tendril_config::ScenarioError::Invalid {
                 file: file.into(),
                 key: format!("parameters.\"{key}\""),
                 reason,
@@ -162,32 +162,32 @@ pub fn check_bounds(
     spec_file: &std::path::Path,
     params: &[Parameter],
     scenarios: &[(&std::path::Path, &toml::Table)],
-) -> Result<(), crate::scenario::ScenarioError> {
+) -> Result<(), tendril_config::ScenarioError> {
     for p in params {
         for (which, v) in [("min", p.min), ("max", p.max), ("start", p.start)] {
             for (file, table) in scenarios {
                 let mut t = (*table).clone();
-                let checked = crate::scenario::apply_overrides(&mut t, &[p.override_at(v)]).and_then(|()| {
-                    crate::scenario::from_table::<crate::run::scenario::PickPlaceScenario>(t, file).map(|_| ())
+                let checked = tendril_config::apply_overrides(&mut t, &[p.override_at(v)]).and_then(|()| {
+                    tendril_config::from_table::<tendril_run::scenario::PickPlaceScenario>(t, file).map(|_| ())
                 });
                 if let Err(e) = checked {
                     let reason = match e {
-                        crate::scenario::ScenarioError::Invalid { reason, .. }
+                        tendril_config::ScenarioError::Invalid { reason, .. }
                             if reason.starts_with("unknown field") =>
                         {
                             format!("not a scenario key: {reason} (in {})", file.display())
                         }
-                        crate::scenario::ScenarioError::Invalid { key, reason, .. } if key == p.key => {
+                        tendril_config::ScenarioError::Invalid { key, reason, .. } if key == p.key => {
                             format!("{which} = {v} is not a valid value of the key: {reason} (in {})", file.display())
                         }
-                        crate::scenario::ScenarioError::Invalid { key, reason, .. }
+                        tendril_config::ScenarioError::Invalid { key, reason, .. }
                             if p.key.starts_with(&key) || key == "(top level)" =>
                         {
                             format!("not a scenario key: {reason} (in {})", file.display())
                         }
                         other => format!("{which} = {v} makes the scenario invalid: {other}"),
                     };
-                    return Err(crate::scenario::ScenarioError::Invalid {
+                    return Err(tendril_config::ScenarioError::Invalid {
                         file: spec_file.into(),
                         key: format!("parameters.\"{}\"", p.key),
                         reason,

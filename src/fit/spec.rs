@@ -39,10 +39,10 @@ use super::optimizer::Budget;
 use super::recording::Recording;
 use super::space::{Parameter, ParameterSpec};
 use super::target::{Target, TargetSpec};
-use crate::scenario::ScenarioError;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use tendril_config::ScenarioError;
 
 /// FIT.toml as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -101,7 +101,7 @@ pub enum SpecError {
 
 /// Reads a TOML spec file into `T`, errors naming the file and the dotted key.
 pub fn read_spec<T: serde::de::DeserializeOwned>(file: &Path) -> Result<T, ScenarioError> {
-    let text = crate::scenario::read_text(file)?;
+    let text = tendril_config::read_text(file)?;
     let table: toml::Table = text
         .parse()
         .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.into(), message: e.to_string() })?;
@@ -187,7 +187,7 @@ impl Fit {
     /// `overlay.toml`); with `evaluations = 1` the fit only scores those values against its
     /// recordings, which is how held-out recordings are predicted. A value that is not a number
     /// or lies outside the parameter's bounds is an error naming the overlay and the key.
-    pub fn start_from(&mut self, overlay: &crate::scenario::Overlay) -> Result<(), ScenarioError> {
+    pub fn start_from(&mut self, overlay: &tendril_config::Overlay) -> Result<(), ScenarioError> {
         let Some(file) = &overlay.file else { return Ok(()) };
         for p in &mut self.params {
             let Some(o) = overlay.overrides.iter().rev().find(|o| o.key == p.key) else { continue };

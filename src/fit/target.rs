@@ -31,11 +31,11 @@
 //! gradually, then to zero").
 
 use super::objective::PHASES;
-use crate::run::runner::RunReport;
-use crate::run::summary::RunSummary;
-use crate::scenario::ScenarioError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use tendril_config::ScenarioError;
+use tendril_run::runner::RunReport;
+use tendril_run::summary::RunSummary;
 
 /// A `[[targets]]` entry as written.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -282,13 +282,13 @@ impl Target {
             return Err(invalid(&key, reason));
         }
         let file = base.join(&spec.scenario);
-        let text = crate::scenario::read_text(&file)
+        let text = tendril_config::read_text(&file)
             .map_err(|e| invalid("scenario", format!("cannot read {}: {e}", file.display())))?;
         let mut table: toml::Table = text
             .parse()
             .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.clone(), message: e.to_string() })?;
         table.insert("feedback".into(), toml::Value::Boolean(spec.feedback));
-        let scenario: crate::run::scenario::PickPlaceScenario = crate::scenario::from_table(table.clone(), &file)?;
+        let scenario: tendril_run::scenario::PickPlaceScenario = tendril_config::from_table(table.clone(), &file)?;
         let name = spec
             .name
             .clone()

@@ -29,13 +29,13 @@ use super::log::EvalLog;
 use super::optimizer::{Budget, Evaluation, FAILED, minimize};
 use super::space::{Parameter, ParameterSpec};
 use super::spec::{invalid, read_spec};
-use crate::run::runner::RunReport;
-use crate::run::summary::RunSummary;
-use crate::scenario::{Overlay, Override, ScenarioError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use tendril_config::{Overlay, Override, ScenarioError};
+use tendril_run::runner::RunReport;
+use tendril_run::summary::RunSummary;
 
 /// The objective's weights (`[objective]` in TUNE.toml).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -164,7 +164,7 @@ impl Tune {
         for seed in &seeds {
             for d in &self.disturbances {
                 let mut o = d.clone();
-                o.extend(seed.map(|s| Override { key: "seed".into(), value: crate::scenario::seed::to_toml(s) }));
+                o.extend(seed.map(|s| Override { key: "seed".into(), value: tendril_config::seed::to_toml(s) }));
                 o.extend(
                     controller_type
                         .map(|t| Override { key: "controller.type".into(), value: toml::Value::String(t.into()) }),
@@ -189,15 +189,12 @@ pub fn load_tune(file: &Path, overlay: &Overlay) -> Result<Tune, ScenarioError> 
         return Err(invalid(file, bad));
     }
     for t in &spec.controller_types {
-        if !crate::control::controller::ControllerConfig::TYPES.contains(&t.as_str()) {
+        if !tendril_control::ControllerConfig::TYPES.contains(&t.as_str()) {
             return Err(invalid(
                 file,
                 (
                     "controller_types".into(),
-                    format!(
-                        "unknown type `{t}` (expected one of {:?})",
-                        crate::control::controller::ControllerConfig::TYPES
-                    ),
+                    format!("unknown type `{t}` (expected one of {:?})", tendril_control::ControllerConfig::TYPES),
                 ),
             ));
         }
@@ -216,16 +213,16 @@ pub fn load_tune(file: &Path, overlay: &Overlay) -> Result<Tune, ScenarioError> 
     let mut scenarios = Vec::new();
     for path in &spec.scenarios {
         let path = base.join(path);
-        let text = crate::scenario::read_text(&path)?;
+        let text = tendril_config::read_text(&path)?;
         let mut table: toml::Table = text
             .parse()
             .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: path.clone(), message: e.to_string() })?;
-        crate::scenario::apply_overrides(&mut table, &overlay.overrides)?;
-        let scenario: crate::run::scenario::PickPlaceScenario =
-            crate::scenario::from_table(table.clone(), &path).map_err(|e| overlay.attribute(e, &[]))?;
+        tendril_config::apply_overrides(&mut table, &overlay.overrides)?;
+        let scenario: tendril_run::scenario::PickPlaceScenario =
+            tendril_config::from_table(table.clone(), &path).map_err(|e| overlay.attribute(e, &[]))?;
         let name = path
             .file_stem()
-            .map_or_else(|| "scenario".into(), |s| crate::run::output::sanitize_component(&s.to_string_lossy()));
+            .map_or_else(|| "scenario".into(), |s| tendril_run::output::sanitize_component(&s.to_string_lossy()));
         if scenarios.iter().any(|s: &TuneScenario| s.name == name) {
             return Err(invalid(
                 file,
@@ -260,8 +257,8 @@ pub fn load_tune(file: &Path, overlay: &Overlay) -> Result<Tune, ScenarioError> 
         for t in &types {
             for (i, case) in tune.cases(*t).iter().enumerate() {
                 let mut table = s.table.clone();
-                let checked = crate::scenario::apply_overrides(&mut table, case).and_then(|()| {
-                    crate::scenario::from_table::<crate::run::scenario::PickPlaceScenario>(table.clone(), &s.file)
+                let checked = tendril_config::apply_overrides(&mut table, case).and_then(|()| {
+                    tendril_config::from_table::<tendril_run::scenario::PickPlaceScenario>(table.clone(), &s.file)
                 });
                 if let Err(e) = checked {
                     return Err(invalid(
@@ -345,7 +342,7 @@ pub fn run_tune(
     for scenario in &tune.scenarios {
         let mut best_of_scenario: Option<(f64, Vec<f64>, Option<&str>)> = None;
         for &t in &types {
-            if crate::interrupt::requested().is_some() {
+            if tendril_cell::interrupt::requested().is_some() {
                 break;
             }
             let dir = match t {
@@ -384,7 +381,7 @@ pub fn run_tune(
                     (r.values[ix], y, r.exact_objective().unwrap_or(FAILED), r.failed)
                 })
                 .collect();
-            let chart = crate::plot::fit::LandscapeChart {
+            let chart = tendril_plot::fit::LandscapeChart {
                 title: format!("{label}: objective landscape, {} evaluations", result.history.len()),
                 axes: (
                     tune.params[ix].key.clone(),
@@ -402,7 +399,7 @@ pub fn run_tune(
                     )
                 }),
             };
-            written.extend(crate::plot::save(&chart, &dir, "landscape")?);
+            written.extend(tendril_plot::save(&chart, &dir, "landscape")?);
             if best_of_scenario.as_ref().is_none_or(|b| objective < b.0) && result.best_record.is_some() {
                 best_of_scenario = Some((objective, result.best.clone(), t));
             }

@@ -11,33 +11,18 @@
 //! - [`overlay`]: the force-trace panel.
 //! - [`video`]: H.264 (OpenH264) in MP4.
 
-pub mod frames;
 pub mod overlay;
 pub mod video;
 
-use crate::cell::physics::SceneModel;
-use crate::run::scenario::PickPlaceScenario;
-use frames::{FRAMES_FILE, FrameLog};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtFrame, mjtJoint, mjtVisFlag};
 use mujoco_rs::prelude::{MjData, MjModel};
 use mujoco_rs::renderer::{MjRenderer, RendererError};
 use mujoco_rs::wrappers::mj_visualization::MjvCamera;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-/// One state of the scene in MuJoCo's layout (the compiled [`SceneModel`]'s `qpos`, `qvel`,
-/// `ctrl`, `act`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Snapshot {
-    /// Generalised positions.
-    pub qpos: Vec<f64>,
-    /// Generalised velocities.
-    pub qvel: Vec<f64>,
-    /// Actuator controls.
-    pub ctrl: Vec<f64>,
-    /// Actuator activations.
-    pub act: Vec<f64>,
-}
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_twin::frames::{self, FRAMES_FILE, FrameLog};
+use tendril_twin::physics::SceneModel;
 
 /// Largest picture side \[px\] (and so the offscreen buffer's).
 pub const MAX_SIDE: u32 = 4096;
@@ -177,7 +162,7 @@ pub(crate) fn dress_for_screen(model: &mut MjModel, scene: &SceneModel) {
     let vis = model.vis_mut();
     vis.headlight.ambient = [0.35, 0.35, 0.35];
     vis.headlight.diffuse = [0.6, 0.6, 0.6];
-    for &g in &scene.ids().pad_geoms {
+    for &g in scene.pad_geoms() {
         model.geom_rgba_mut()[g] = [1.0, 0.45, 0.0, 1.0];
     }
 }
@@ -185,10 +170,9 @@ pub(crate) fn dress_for_screen(model: &mut MjModel, scene: &SceneModel) {
 /// Where the free camera looks in `data`'s state: the object's grip, or the hand when the scene
 /// has no object.
 pub(crate) fn camera_target(scene: &SceneModel, data: &MjData<Arc<MjModel>>) -> [f64; 3] {
-    let ids = scene.ids();
-    match ids.object_grip {
+    match scene.object_grip_geom() {
         Some(g) => data.geom_xpos()[g],
-        None => data.xpos()[ids.hand_body],
+        None => data.xpos()[scene.hand_body()],
     }
 }
 
@@ -205,9 +189,9 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
     if !scenario_path.is_file() {
         anyhow::bail!("{}: no such file: the run directory must hold the run's scenario.toml", scenario_path.display());
     }
-    let scenario: PickPlaceScenario = crate::scenario::load(&scenario_path, &[])?;
+    let scenario: PickPlaceScenario = tendril_config::load(&scenario_path, &[])?;
     let scene = SceneModel::build(&scenario.scene_spec())?;
-    let trace = if opts.panel { Some(crate::plot::trace::read(run_dir)?) } else { None };
+    let trace = if opts.panel { Some(tendril_plot::trace::read(run_dir)?) } else { None };
 
     // The run's model with what only the picture needs changed: the offscreen buffer's size and
     // the sensor pad's colour.
@@ -268,7 +252,7 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
     let mut options = mujoco_rs::wrappers::mj_visualization::MjvOption::default();
     // Contact forces as MuJoCo draws them. A rapier run's states are drawn through the same model,
     // but MuJoCo's contact solve at rapier's penetrations is not rapier's force: left out there.
-    let mujoco = scenario.scene_spec().physics.backend == crate::cell::physics::Backend::Mujoco;
+    let mujoco = scenario.scene_spec().physics.backend == tendril_twin::physics::Backend::Mujoco;
     options.flags[mjtVisFlag::mjVIS_CONTACTFORCE as usize] = u8::from(mujoco);
     options.frame = mjtFrame::mjFRAME_NONE as i32;
     let mut renderer = MjRenderer::builder()
@@ -329,7 +313,7 @@ pub(crate) fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> any
         let mut writer = encoder.write_header().map_err(|e| failed(&e))?;
         writer.write_image_data(rgb).map_err(|e| failed(&e))?;
     }
-    crate::run::output::write_atomically(path, &bytes)
+    tendril_config::write_atomically(path, &bytes)
         .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
 }
 

@@ -2,9 +2,9 @@
 //! setpoint) over the whole run, a cursor at the frame's time, and the phase and forces at that
 //! time as text. The chart is drawn once; each frame copies it and adds the cursor and the text.
 
-use crate::plot::style::{self, FONT};
-use crate::plot::trace::{RunTrace, TracePoint};
 use plotters::prelude::*;
+use tendril_plot::style::{self, FONT};
+use tendril_plot::trace::{RunTrace, TracePoint};
 
 /// Cursor colour.
 const CURSOR: RGBColor = RGBColor(200, 30, 30);

@@ -150,7 +150,7 @@ impl Mp4Encoder {
         }
         writer.write_end().map_err(mp4_error)?;
         let bytes = buf.into_inner();
-        crate::run::output::write_atomically(path, &bytes)
+        tendril_config::write_atomically(path, &bytes)
             .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))?;
         Ok(bytes.len() as u64)
     }

@@ -1,12 +1,12 @@
 //! The paper's Sec. V on the twin: the three objects with and without force feedback.
 
 use super::Row;
-use crate::run::execute::{ModelCache, run_on_twin};
-use crate::run::scenario::PickPlaceScenario;
-use crate::run::summary::RunSummary;
-use crate::scenario::Override;
 use rayon::prelude::*;
 use std::path::Path;
+use tendril_config::Override;
+use tendril_run::execute::{ModelCache, run_on_twin};
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::summary::RunSummary;
 
 /// What the paper reports for one object (Sec. V-C, Fig. 9).
 struct PaperObject {
@@ -43,7 +43,7 @@ pub fn rows(scenario_dir: &Path, overrides: &[Override]) -> anyhow::Result<Vec<R
             let file = scenario_dir.join(format!("{}.toml", PAPER[i].scenario));
             let mut o = overrides.to_vec();
             o.push(Override { key: "feedback".into(), value: toml::Value::Boolean(feedback) });
-            let scenario: PickPlaceScenario = crate::scenario::load(&file, &o)?;
+            let scenario: PickPlaceScenario = tendril_config::load(&file, &o)?;
             Ok(run_on_twin(&scenario, &models, None)?.0)
         })
         .collect();

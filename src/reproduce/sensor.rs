@@ -7,12 +7,12 @@
 //! reports what it does on the validation run.
 
 use super::Row;
-use crate::calibration::{self, BenchRecord};
-use crate::control::estimate::ForceCalibration;
-use crate::scenario;
-use crate::sensor_bench::{self, BenchScenario};
 use anyhow::Context;
 use std::path::Path;
+use tendril_config as scenario;
+use tendril_fbg::bench::BenchScenario;
+use tendril_fbg::calibration::{self, BenchRecord};
+use tendril_fbg::estimate::ForceCalibration;
 
 /// Scenario files read from the scenario folder.
 pub const SCENARIOS: [&str; 4] = [
@@ -30,7 +30,7 @@ pub fn paper_curve_pm(n: f64) -> f64 {
 /// Loads and runs one bench scenario.
 pub fn run_scenario(path: &Path) -> anyhow::Result<(BenchScenario, BenchRecord)> {
     let s: BenchScenario = scenario::load(path, &[])?;
-    let record = sensor_bench::run(&s);
+    let record = tendril_fbg::bench::run(&s);
     Ok((s, record))
 }
 

@@ -24,10 +24,10 @@
 //! workers through [`super::run_all`].
 
 use super::{cell, run_all, set, write_csv};
-use crate::plot::controllers::{COLUMNS, ControllerRow, render};
-use crate::plot::controllers_summary::{SummaryRow, aggregate};
-use crate::scenario::Override;
 use std::path::{Path, PathBuf};
+use tendril_config::Override;
+use tendril_plot::controllers::{COLUMNS, ControllerRow, render};
+use tendril_plot::controllers_summary::{SummaryRow, aggregate};
 
 /// The controllers compared (`[controller] type`), each at its defaults over the scenario's gains.
 pub const CONTROLLERS: [&str; 3] = ["pid", "feedforward", "slip_margin"];

@@ -9,10 +9,10 @@
 //! settings against each other (so the reference itself is shown converged).
 
 use super::{StudyRun, cell, run_all, set, write_csv};
-use crate::plot::convergence::{ConvergenceRow, render};
-use crate::run::metrics::despiked;
-use crate::run::trace::TraceRow;
 use std::path::{Path, PathBuf};
+use tendril_plot::convergence::{ConvergenceRow, render};
+use tendril_run::metrics::despiked;
+use tendril_run::trace::TraceRow;
 
 /// The study halves the timestep down to this one at least \[s\] unless asked for a finer one
 /// (`tendril chart convergence --finest-step`): the "down to at least 0.625 ms" (and always
@@ -264,12 +264,7 @@ fn case_label(case: &Case) -> String {
 
 /// Runs every case at every setting of `plan` (`extra` overrides on all, for example the backend)
 /// on `threads` workers, and judges the plan's pairs.
-pub fn study(
-    cases: &[Case],
-    plan: &Plan,
-    extra: &[crate::scenario::Override],
-    threads: usize,
-) -> anyhow::Result<Study> {
+pub fn study(cases: &[Case], plan: &Plan, extra: &[tendril_config::Override], threads: usize) -> anyhow::Result<Study> {
     let mut rows = Vec::new();
     let mut verdicts = Vec::new();
     // One batch per scenario file (run_all loads one file), all its cases and settings at once.
@@ -330,7 +325,7 @@ pub fn study(
 pub fn run(
     cases: &[Case],
     plan: &Plan,
-    extra: &[crate::scenario::Override],
+    extra: &[tendril_config::Override],
     threads: usize,
     out: &Path,
 ) -> anyhow::Result<(Study, Vec<PathBuf>)> {
@@ -430,7 +425,7 @@ mod tests {
 
     #[test]
     fn the_force_trace_is_compared_while_held_and_up_to_the_drop_criterion_before_a_drop() {
-        use crate::control::task::Phase;
+        use tendril_control::task::Phase;
         // Two held traces 0.01 N apart at 100 Hz, the second striking the pad with 2 N for 0.1 s in
         // the breakaway 0.3 s before a drop at 10 s.
         let trace = |offset: f64, strike: bool| -> Vec<TraceRow> {

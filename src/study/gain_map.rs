@@ -2,8 +2,8 @@
 //! (Kp, Ki) grid with feedback on.
 
 use super::{run_all, set, write_csv};
-use crate::plot::gain_map::{GainMapRow, render};
 use std::path::{Path, PathBuf};
+use tendril_plot::gain_map::{GainMapRow, render};
 
 /// Kp values tried [(°/s)/N]: a decade each side of the paper's 20.
 pub const KP: [f64; 7] = [2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0];

@@ -1,6 +1,6 @@
 //! The real path under timing jitter: the scenario run against the virtual devices (`tendril
 //! serve`'s, in-process, in real time) while they hold back and bunch their packets, each run
-//! compared phase by phase with the same scenario on the twin ([`crate::run::compare`]), with the
+//! compared phase by phase with the same scenario on the twin ([`tendril_run::compare`]), with the
 //! default watchdogs. What it tells: how much jitter the real path tolerates with its answers
 //! unchanged, and from what jitter on the watchdogs stop it.
 //!
@@ -10,15 +10,14 @@
 //! time, and two side by side on a 2-core machine would starve each other's deadlines).
 
 use super::{cell, write_csv};
-use crate::cell::real::RealCellConfig;
-use crate::cell::real::serve::jitter::Link;
-use crate::cell::real::serve::{Jitter, JitterModel, JitterProfile, ServeConfig, start};
-use crate::control::task::Phase;
-use crate::plot::jitter::{JitterRow, render};
-use crate::run::compare::{TOLERANCES, Tick, compare, first_disagreement};
-use crate::run::execute::run_on_twin;
-use crate::run::real::run_on_real;
 use std::path::{Path, PathBuf};
+use tendril_control::task::Phase;
+use tendril_plot::jitter::{JitterRow, render};
+use tendril_run::compare::{TOLERANCES, Tick, compare, first_disagreement};
+use tendril_run::execute::run_on_twin;
+use tendril_run::real::run_on_real;
+use tendril_serve::jitter::Link;
+use tendril_serve::{Jitter, JitterModel, JitterProfile, ServeConfig, start};
 
 /// Stall rate of the swept cases [1/s]: the busy-PC profile's.
 pub const STALL_RATE_HZ: f64 = 2.0;
@@ -82,7 +81,7 @@ const PHASES: [Phase; 4] = [Phase::Grow, Phase::Wrap, Phase::Grasp, Phase::Lift]
 
 /// Runs every case with every seed on `scenario`, writes `jitter.csv` and its chart into `out`.
 pub fn run(scenario: &Path, cases: &[JitterCase], seeds: &[u64], out: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let s: crate::run::scenario::PickPlaceScenario = crate::scenario::load(scenario, &[])?;
+    let s: tendril_run::scenario::PickPlaceScenario = tendril_config::load(scenario, &[])?;
     let (twin_summary, twin) = run_on_twin(&s, &Default::default(), None)?;
     anyhow::ensure!(twin.error.is_none(), "{}: the twin's run failed: {:?}", scenario.display(), twin.error);
     let twin: Vec<Tick> = twin.rows.iter().map(Tick::from).collect();
@@ -93,7 +92,7 @@ pub fn run(scenario: &Path, cases: &[JitterCase], seeds: &[u64], out: &Path) -> 
             let mut config = ServeConfig::ephemeral();
             config.jitter = case.model.map(|model| Jitter { model, seed, only: case.only });
             let serve = start(&s, &config)?;
-            let cell = RealCellConfig::for_virtual_devices(&serve).with_control_rate(s.control_rate_hz);
+            let cell = serve.real_cell_config().with_control_rate(s.control_rate_hz);
             let result = run_on_real(&s, cell, None);
             serve.stop().map_err(|e| anyhow::anyhow!("virtual devices: {e}"))?;
             let (summary, report) = result?;
@@ -114,6 +113,7 @@ pub fn run(scenario: &Path, cases: &[JitterCase], seeds: &[u64], out: &Path) -> 
                     && summary.outcome == twin_summary.outcome
                     && first_disagreement(&comparisons, &TOLERANCES).is_none(),
                 drop_alarms: summary.drop_alarms,
+                tolerance_n: TOLERANCES.carry_n,
                 oldest_sample_ms: timing.sensor_age.max_ms.max(timing.arm_age.max_ms).max(timing.motor_age.max_ms),
                 error: summary.error.unwrap_or_default(),
             });
@@ -137,6 +137,7 @@ pub fn run(scenario: &Path, cases: &[JitterCase], seeds: &[u64], out: &Path) -> 
                 cell(r.lift_gap_n.is_finite().then_some(r.lift_gap_n)),
                 r.agrees.to_string(),
                 r.drop_alarms.to_string(),
+                r.tolerance_n.to_string(),
                 r.oldest_sample_ms.to_string(),
                 r.error.clone(),
             ]
@@ -153,6 +154,7 @@ pub fn run(scenario: &Path, cases: &[JitterCase], seeds: &[u64], out: &Path) -> 
         "lift_gap_n",
         "agrees",
         "drop_alarms",
+        "tolerance_n",
         "oldest_sample_ms",
         "error",
     ];

@@ -1,7 +1,7 @@
 //! Studies over many runs: speed against accuracy, stability limits, gain maps, controllers.
 //!
 //! Each study loads one scenario with overrides per run, runs it on the twin, writes a CSV and
-//! draws its chart with [`crate::plot`].
+//! draws its chart with [`tendril_plot`].
 //!
 //! - [`convergence`]: each Section V case under timestep and finger-link refinement.
 //! - [`speed_accuracy`]: timestep × integrator × cone × finger links against a fine reference.
@@ -19,13 +19,13 @@ pub mod jitter;
 pub mod speed_accuracy;
 pub mod stability;
 
-use crate::run::execute::{ModelCache, run_on_twin};
-use crate::run::runner::RunReport;
-use crate::run::scenario::PickPlaceScenario;
-use crate::run::summary::RunSummary;
-use crate::scenario::Override;
 use rayon::prelude::*;
 use std::path::Path;
+use tendril_config::Override;
+use tendril_run::execute::{ModelCache, run_on_twin};
+use tendril_run::runner::RunReport;
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::summary::RunSummary;
 
 /// `key=value` as an override (the value parsed as TOML, like `--set`).
 pub fn set(key: &str, value: impl std::fmt::Display) -> Override {
@@ -46,7 +46,7 @@ pub struct StudyRun {
 /// studies, so runs do not compete for cores). Bad keys or values fail before anything runs.
 pub fn run_all(scenario: &Path, sets: Vec<Vec<Override>>, threads: usize) -> anyhow::Result<Vec<StudyRun>> {
     let scenarios: Vec<PickPlaceScenario> =
-        sets.iter().map(|o| crate::scenario::load(scenario, o)).collect::<Result<_, _>>()?;
+        sets.iter().map(|o| tendril_config::load(scenario, o)).collect::<Result<_, _>>()?;
     let models = ModelCache::default();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     let progress = indicatif::ProgressBar::new(sets.len() as u64);

@@ -10,8 +10,8 @@
 
 use super::convergence::force_rmse;
 use super::{cell, run_all, set, write_csv};
-use crate::plot::speed_accuracy::{SpeedAccuracyRow, render};
 use std::path::{Path, PathBuf};
+use tendril_plot::speed_accuracy::{SpeedAccuracyRow, render};
 
 /// The grid of a speed/accuracy study.
 #[derive(Debug, Clone)]
@@ -118,7 +118,7 @@ impl Point {
         }
     }
 
-    fn overrides(&self) -> Vec<crate::scenario::Override> {
+    fn overrides(&self) -> Vec<tendril_config::Override> {
         let mut o = vec![
             set("physics.timestep_s", self.timestep_s),
             set("finger.segments", self.segments),

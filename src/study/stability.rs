@@ -3,8 +3,8 @@
 //! lost grasp (the object dropped although the run at the project's defaults holds it).
 
 use super::{cell, run_all, set, write_csv};
-use crate::plot::stability::{StabilityRow, render};
 use std::path::{Path, PathBuf};
+use tendril_plot::stability::{StabilityRow, render};
 
 /// Timesteps tried \[s\], from MuJoCo's usual 1 ms to the largest a scenario accepts (50 ms).
 pub const TIMESTEPS_S: [f64; 7] = [0.001, 0.002, 0.005, 0.01, 0.02, 0.03, 0.05];

@@ -5,8 +5,8 @@
 //! the sweep ([`ResultsFile::open`]):
 //! - a last line without its newline is a torn row: it is cut off and its run is run again (a
 //!   row is only done when its newline is on disk; rows never hold a line break, see
-//!   [`super::results::row`]);
-//! - a torn or foreign header, a row of another sweep (another [`super::results::sweep_id`]), or a
+//!   [`super::columns::row`]);
+//! - a torn or foreign header, a row of another sweep (another [`super::columns::sweep_id`]), or a
 //!   complete line that is not a whole row of this sweep (a fragment glued to a row) are refused,
 //!   naming the file and line: nothing is guessed;
 //! - an exclusive lock on the file (`flock`, released when the process dies) stops a second
@@ -15,7 +15,7 @@
 //! Each row is written with one `write` and synced; if the write fails (disk full) the file is cut
 //! back to its last whole row, so what was written before is kept and nothing torn is left.
 
-use super::results::{SWEEP_ID_COLUMN, identity_cells, identity_columns, scenario_name};
+use super::columns::{SWEEP_ID_COLUMN, identity_cells, identity_columns, scenario_name};
 use super::{Shard, Sweep};
 use std::collections::BTreeSet;
 use std::io::{Seek, Write};
@@ -198,9 +198,9 @@ pub fn read_regular(path: &Path) -> Result<Vec<u8>, ResultsError> {
     std::fs::read(path).map_err(|source| ResultsError::io(path, source))
 }
 
-/// Writes `bytes` over `path` atomically ([`crate::run::output::write_atomically`]).
+/// Writes `bytes` over `path` atomically ([`tendril_config::write_atomically`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ResultsError> {
-    crate::run::output::write_atomically(path, bytes).map_err(|(file, cause)| ResultsError::Io { file, cause })
+    tendril_config::write_atomically(path, bytes).map_err(|(file, cause)| ResultsError::Io { file, cause })
 }
 
 /// What opening a results file found.

@@ -1,15 +1,15 @@
 //! Running a sweep: check every run first, then run them in parallel, appending each result
 //! to `results.csv` as it finishes.
 
+use super::columns::{header, row, sweep_id};
 use super::durable::ResultsFile;
-use super::results::{header, row, sweep_id};
 use super::{Shard, Sweep, SweepRun};
-use crate::run::execute::{ModelCache, run_on_twin};
-use crate::run::scenario::PickPlaceScenario;
-use crate::run::summary::RunSummary;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use tendril_run::execute::{ModelCache, run_on_twin};
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::summary::RunSummary;
 
 /// How to run a sweep.
 #[derive(Debug, Clone)]
@@ -58,13 +58,13 @@ pub fn results_path(out_dir: &Path, shard: Option<Shard>) -> PathBuf {
 ///
 /// A bad value that came from the sweep file (a grid or list value) is reported against the
 /// sweep file, at `grid."key"` or `list[i].key`, with the run and scenario it was found in.
-pub fn check_runs(sweep: &Sweep) -> Result<(), crate::scenario::ScenarioError> {
-    use crate::scenario::ScenarioError;
+pub fn check_runs(sweep: &Sweep) -> Result<(), tendril_config::ScenarioError> {
+    use tendril_config::ScenarioError;
     // Each scenario file is read and parsed once; the runs only differ in their overrides.
     let mut tables: std::collections::HashMap<&Path, toml::Table> = Default::default();
     for run in &sweep.runs {
         if !tables.contains_key(run.scenario.as_path()) {
-            let text = crate::scenario::read_text(&run.scenario)?;
+            let text = tendril_config::read_text(&run.scenario)?;
             let table = text.parse().map_err(|e: toml::de::Error| ScenarioError::Syntax {
                 file: run.scenario.clone(),
                 message: e.to_string(),
@@ -72,8 +72,8 @@ pub fn check_runs(sweep: &Sweep) -> Result<(), crate::scenario::ScenarioError> {
             tables.insert(&run.scenario, table);
         }
         let mut table = tables[run.scenario.as_path()].clone();
-        let loaded = crate::scenario::apply_overrides(&mut table, &sweep.overlay.then(&run.overrides))
-            .and_then(|()| crate::scenario::from_table::<PickPlaceScenario>(table, &run.scenario))
+        let loaded = tendril_config::apply_overrides(&mut table, &sweep.overlay.then(&run.overrides))
+            .and_then(|()| tendril_config::from_table::<PickPlaceScenario>(table, &run.scenario))
             .map_err(|e| sweep.overlay.attribute(e, &run.overrides));
         match loaded {
             Ok(_) => {}
@@ -137,12 +137,14 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
     let outcomes: Vec<anyhow::Result<Option<(bool, f64)>>> = pool.install(|| {
         todo.par_iter()
             .map(|run| {
-                if crate::interrupt::requested().is_some() || write_failed.load(std::sync::atomic::Ordering::SeqCst) {
+                if tendril_cell::interrupt::requested().is_some()
+                    || write_failed.load(std::sync::atomic::Ordering::SeqCst)
+                {
                     return Ok(None);
                 }
                 let summary = execute_one(sweep, run, &models);
                 // A run cut short by an operator stop is not done: no row, so --resume runs it.
-                if crate::interrupt::requested().is_some() {
+                if tendril_cell::interrupt::requested().is_some() {
                     return Ok(None);
                 }
                 let cells = row(sweep, &id, run, &summary);

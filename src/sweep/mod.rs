@@ -5,6 +5,7 @@
 //! - [`durable`]: checking, repairing and locking a results file before a resume appends.
 //! - [`execute`]: checking and running the runs in parallel.
 
+pub mod columns;
 pub mod durable;
 pub mod execute;
 pub mod results;

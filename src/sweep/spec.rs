@@ -10,10 +10,10 @@
 //! feedback = false
 //! ```
 
-use crate::scenario::{Override, ScenarioError};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use tendril_config::{Override, ScenarioError};
 
 /// A sweep as written in its file.
 #[derive(Debug, Clone, Deserialize)]
@@ -60,7 +60,7 @@ pub struct Sweep {
     /// The runs, in id order.
     pub runs: Vec<SweepRun>,
     /// `--overlay`: applied to every run before its own overrides (empty by default).
-    pub overlay: crate::scenario::Overlay,
+    pub overlay: tendril_config::Overlay,
 }
 
 fn invalid(file: &Path, key: &str, reason: impl Into<String>) -> ScenarioError {
@@ -70,7 +70,7 @@ fn invalid(file: &Path, key: &str, reason: impl Into<String>) -> ScenarioError {
 /// Reads a sweep file and expands it into runs. Scenario contents are not checked here; see
 /// [`super::execute::check_runs`].
 pub fn load_sweep(file: &Path) -> Result<Sweep, ScenarioError> {
-    let text = crate::scenario::read_text(file)?;
+    let text = tendril_config::read_text(file)?;
     let table: toml::Table = text
         .parse()
         .map_err(|e: toml::de::Error| ScenarioError::Syntax { file: file.into(), message: e.to_string() })?;

@@ -5,11 +5,6 @@
 use super::keys::{self, Controls};
 use super::pace::Pacer;
 use super::{ViewError, ViewOptions};
-use crate::cell::sim::SimCell;
-use crate::control::task::Phase;
-use crate::hardware::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle};
-use crate::run::runner::Outcome;
-use crate::run::trace::TraceRow;
 use mujoco_rs::mujoco_c::mjtState;
 use mujoco_rs::viewer::{MjViewer, egui};
 use mujoco_rs::wrappers::mj_rendering::MjrRectangle;
@@ -17,6 +12,11 @@ use std::cell::RefCell;
 use std::path::Path;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
+use tendril_cell::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle};
+use tendril_control::task::Phase;
+use tendril_run::runner::Outcome;
+use tendril_run::trace::TraceRow;
+use tendril_twin::sim::SimCell;
 
 /// Wall time between two frames: 60 frames/s at most, whatever the speed factor.
 pub const FRAME: Duration = Duration::from_micros(16_667);
@@ -193,8 +193,8 @@ impl LiveCell {
             Some("closing the viewer")
         } else if self.deadline.is_some_and(|d| Instant::now() >= d) {
             Some("the --seconds limit")
-        } else if let Some(signal) = crate::interrupt::requested() {
-            Some(crate::interrupt::name(signal))
+        } else if let Some(signal) = tendril_cell::interrupt::requested() {
+            Some(tendril_cell::interrupt::name(signal))
         } else {
             None
         }
@@ -331,7 +331,7 @@ pub const CAMERA_DISTANCE_M: f64 = 0.6;
 /// orange. Only what the viewer draws differs; the sim keeps its own model.
 fn viewer_model(sim: &SimCell) -> mujoco_rs::prelude::MjModel {
     let shared = sim.model();
-    let start = crate::cell::physics::Scene::new(shared.clone());
+    let start = tendril_twin::physics::Scene::new(shared.clone());
     let mut model = (**shared.model()).clone();
     model.stat_mut().center = crate::render::camera_target(shared, start.data());
     model.stat_mut().extent = CAMERA_DISTANCE_M / 1.5;

@@ -1,12 +1,11 @@
 //! The twin live in MuJoCo's interactive viewer (`tendril view`).
 //!
-//! The run is the one `tendril run` makes ([`crate::run::runner`]'s task and controller loop on a
-//! [`SimCell`]) with the simulated cell wrapped in a [`LiveCell`]: after the physics reaches each
-//! control tick, the live cell syncs the viewer with the sim's own `MjData` (the viewer's mouse
-//! perturbation comes back into it as forces on the next steps), draws a frame when one is due
-//! and waits until the tick is due on the wall clock at the chosen speed ([`pace`]). A hook on
-//! the run loop ([`crate::run::runner::TickHook`]) hands each tick's row to the on-screen panel
-//! and applies the feedback key to the task sequencer.
+//! The run is the one `tendril run` makes (a [`tendril_run::session::Session`] on a [`tendril_twin::sim::SimCell`])
+//! with the simulated cell wrapped in a [`LiveCell`]: after the physics reaches each control tick,
+//! the live cell syncs the viewer with the sim's own `MjData` (the viewer's mouse perturbation
+//! comes back into it as forces on the next steps), draws a frame when one is due and waits until
+//! the tick is due on the wall clock at the chosen speed ([`pace`]). Between ticks the view hands
+//! each tick's row to the on-screen panel and applies the feedback key to the session.
 //!
 //! - [`display`]: whether there is a display to open a window on.
 //! - [`keys`]: the keys and what they ask of the run.
@@ -18,14 +17,12 @@ pub mod keys;
 pub mod live;
 pub mod pace;
 
-use crate::cell::physics::{Backend, SceneModel};
-use crate::cell::sim::SimCell;
-use crate::control::task::TaskSequencer;
-use crate::run::runner::{Outcome, run_task_observed};
-use crate::run::scenario::PickPlaceScenario;
-use crate::run::trace::TraceRow;
 pub use live::LiveCell;
 use std::path::PathBuf;
+use tendril_run::runner::Outcome;
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::session::{Action, Session};
+use tendril_twin::physics::{Backend, SceneModel};
 
 /// Why the viewer could not show the run.
 #[derive(Debug, thiserror::Error)]
@@ -104,20 +101,21 @@ pub fn view(scenario: &PickPlaceScenario, opts: &ViewOptions) -> anyhow::Result<
     }
     let display = display::current_display().ok_or(ViewError::NoDisplay)?;
     let model = SceneModel::build(&spec)?;
-    let cell = SimCell::for_scenario(scenario, model);
+    let cell = scenario.sim_cell(model);
     let mut live = LiveCell::open(cell, &display, &scenario.name, opts)?;
     let plan = scenario.control_plan();
     let status = live.status();
     status.borrow_mut().feedback = plan.feedback;
-    let mut hook = move |row: &TraceRow, sequencer: &mut TaskSequencer| {
+    let mut session = Session::start(&mut live, &plan, plan.controller.build(), None);
+    while let Some(row) = session.step(Action::Controller) {
         let mut s = status.borrow_mut();
         if s.controls.take_feedback_switch() {
-            sequencer.set_feedback(!sequencer.feedback());
+            session.set_feedback(!session.feedback());
         }
-        s.row = Some(*row);
-        s.feedback = sequencer.feedback();
-    };
-    let report = run_task_observed(&mut live, &plan, plan.controller.build(), None, &mut hook);
+        s.row = Some(row);
+        s.feedback = session.feedback();
+    }
+    let (report, _) = session.finish();
     live.finished(report.outcome, report.error.as_deref());
     live.hold()?;
     if let Some(path) = &opts.screenshot {

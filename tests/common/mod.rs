@@ -6,7 +6,7 @@
 pub mod cli;
 pub mod phases;
 
-use tendril::run::scenario::PickPlaceScenario;
+use tendril_run::scenario::PickPlaceScenario;
 
 /// These tests run the twin in real time behind live sockets and a pty; side by side on a 2-core
 /// machine they would starve each other's deadlines, so they take turns.
@@ -23,6 +23,6 @@ pub const SHORT_LIFT: &str = "scenarios/short-lift.toml";
 /// [`SHORT_LIFT`], loaded with `overrides` (`key=value`, as `--set` takes them).
 pub fn short_lift(overrides: &[&str]) -> PickPlaceScenario {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(SHORT_LIFT);
-    let overrides: Vec<tendril::scenario::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
-    tendril::scenario::load(&path, &overrides).unwrap()
+    let overrides: Vec<tendril_config::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    tendril_config::load(&path, &overrides).unwrap()
 }

@@ -1,10 +1,10 @@
 //! The simulated path against the real path, phase by phase, whether the runs come from memory or
-//! from `trace.csv`: the library's comparison (`tendril::run::compare`, where the tolerances and
+//! from `trace.csv`: the library's comparison (`tendril_run::compare`, where the tolerances and
 //! the measurements behind them are) with the assertions the real-path tests make.
 
-use tendril::control::task::Phase;
-use tendril::run::compare::{TOLERANCES, Tick, compare, describe, first_disagreement};
-use tendril::run::runner::RunReport;
+use tendril_control::task::Phase;
+use tendril_run::compare::{TOLERANCES, Tick, compare, describe, first_disagreement};
+use tendril_run::runner::RunReport;
 
 /// The phases the short grasp-hold-lift goes through, in order.
 pub const PHASES: [Phase; 4] = [Phase::Grow, Phase::Wrap, Phase::Grasp, Phase::Lift];

@@ -7,6 +7,13 @@
 //! - `cargo xtask main`: fetch, then run the main job (`tendril reproduce ...`).
 //! - `cargo xtask test`: fetch, install the Python protocol clients into `vendor/venv`, then run
 //!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv.
+//! - `cargo xtask layers`: check the workspace's rules (the crates' layers, the light crates'
+//!   dependencies, no module loops; [`layers`]).
+//! - `cargo xtask publish-check`: `cargo publish --dry-run` of the crates made to be used on their
+//!   own ([`layers::PUBLISHED`]): each is packaged and built from its package alone.
+
+mod layers;
+mod modules;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -23,8 +30,14 @@ fn main() -> ExitCode {
         "fetch" => fetch_mujoco().map(|_| ()),
         "main" => fetch_mujoco().and_then(|_| run_main(rest)),
         "test" => fetch_mujoco().and_then(|_| run_tests(rest)),
+        "layers" => check_layers(),
+        "publish-check" => run(cargo()
+            .args(["publish", "--dry-run"])
+            .args(layers::PUBLISHED.iter().flat_map(|p| ["--package", p]))
+            .args(rest)
+            .current_dir(workspace_root())),
         _ => {
-            eprintln!("usage: cargo xtask <fetch|main|test> [extra cargo args]");
+            eprintln!("usage: cargo xtask <fetch|main|test|layers|publish-check> [extra cargo args]");
             return ExitCode::from(2);
         }
     };
@@ -116,7 +129,9 @@ fn run_main(extra: &[String]) -> Result<(), String> {
 /// The whole test suite (what `.ci/run` runs).
 fn run_tests(extra: &[String]) -> Result<(), String> {
     let python = python_clients()?;
-    run(cargo().args(["test", "--workspace", "--all-targets"]).args(extra).env("TENDRIL_PYTHON", python))
+    run(cargo().args(["test", "--workspace", "--all-targets"]).args(extra).env("TENDRIL_PYTHON", &python))?;
+    // The crates' READMEs are their docs, and their samples are doctests (`--all-targets` runs none).
+    run(cargo().args(["test", "--workspace", "--doc"]).args(extra).env("TENDRIL_PYTHON", python))
 }
 
 /// Independent protocol clients the tests run against the virtual devices (tests/python_clients.rs),
@@ -138,6 +153,20 @@ fn python_clients() -> Result<PathBuf, String> {
     run(Command::new(&python).args(["-m", "pip", "install", "--quiet", "--only-binary=:all:"]).args(PYTHON_CLIENTS))?;
     std::fs::write(&stamp, "").map_err(|e| format!("{}: {e}", stamp.display()))?;
     Ok(python)
+}
+
+/// `cargo xtask layers`: every broken rule printed; fails if there is one.
+fn check_layers() -> Result<(), String> {
+    let errors = layers::check(&workspace_root(), &cargo)?;
+    if errors.is_empty() {
+        let crates: usize = layers::LAYERS.iter().map(|l| l.len()).sum();
+        println!("layers: {crates} crates in {} layers, every rule holds", layers::LAYERS.len());
+        return Ok(());
+    }
+    for e in &errors {
+        eprintln!("{e}");
+    }
+    Err(format!("{} rule(s) broken", errors.len()))
 }
 
 fn run(cmd: &mut Command) -> Result<(), String> {

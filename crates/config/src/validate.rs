@@ -1,0 +1,81 @@
+//! Range checks on deserialised scenarios, reported by dotted key.
+
+/// Something that can check its own values after deserialisation.
+///
+/// Implementations call the [`Checker`] methods with their field names and descend into
+/// nested sections with [`Checker::section`], so errors carry the full dotted path.
+pub trait Validate {
+    /// Records every out-of-range value in `at`.
+    fn validate(&self, at: &mut Checker);
+
+    /// Prepares the parsed table of a file of this type before it is deserialised (after the
+    /// `--set` overrides): resolves paths relative to `file`, fills defaults that depend on other
+    /// keys. Nothing by default.
+    fn prepare(_table: &mut toml::Table, _file: &std::path::Path)
+    where
+        Self: Sized,
+    {
+    }
+}
+
+/// Collects validation errors under a dotted key prefix.
+#[derive(Debug, Default)]
+pub struct Checker {
+    prefix: Vec<String>,
+    errors: Vec<(String, String)>,
+}
+
+impl Checker {
+    fn key(&self, name: &str) -> String {
+        let mut parts = self.prefix.clone();
+        parts.push(name.to_string());
+        parts.join(".")
+    }
+
+    /// Validates a nested section under `name`.
+    pub fn section(&mut self, name: &str, inner: &impl Validate) {
+        self.prefix.push(name.to_string());
+        inner.validate(self);
+        self.prefix.pop();
+    }
+
+    /// Records an error on key `name` unless `ok` holds.
+    pub fn require(&mut self, name: &str, ok: bool, reason: impl FnOnce() -> String) {
+        if !ok {
+            let key = self.key(name);
+            self.errors.push((key, reason()));
+        }
+    }
+
+    /// `value` must be finite and strictly positive.
+    pub fn positive(&mut self, name: &str, value: f64) {
+        self.require(name, value.is_finite() && value > 0.0, || format!("must be > 0, got {value}"));
+    }
+
+    /// `value` must be finite and not negative.
+    pub fn non_negative(&mut self, name: &str, value: f64) {
+        self.require(name, value.is_finite() && value >= 0.0, || format!("must be >= 0, got {value}"));
+    }
+
+    /// `value` must be finite.
+    pub fn finite(&mut self, name: &str, value: f64) {
+        self.require(name, value.is_finite(), || format!("must be a finite number, got {value}"));
+    }
+
+    /// `value` must lie in `[lo, hi]`.
+    pub fn in_range(&mut self, name: &str, value: f64, lo: f64, hi: f64) {
+        self.require(name, value.is_finite() && (lo..=hi).contains(&value), || {
+            format!("must be between {lo} and {hi}, got {value}")
+        });
+    }
+
+    /// The first error recorded, as (dotted key, reason).
+    pub fn into_first_error(self) -> Option<(String, String)> {
+        self.errors.into_iter().next()
+    }
+
+    /// Every error recorded, as (dotted key, reason).
+    pub fn errors(&self) -> &[(String, String)] {
+        &self.errors
+    }
+}

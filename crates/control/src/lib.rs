@@ -1,0 +1,16 @@
+#![doc = include_str!("../README.md")]
+#![warn(missing_docs)]
+
+pub mod config;
+pub mod contact;
+pub mod controller;
+pub mod feedforward;
+pub mod limits;
+pub mod load;
+pub mod pid;
+pub mod slip;
+pub mod slip_margin;
+pub mod task;
+pub mod trajectory;
+
+pub use config::ControllerConfig;

@@ -1,0 +1,137 @@
+//! One scenario, start to finish, on the twin: build (or reuse) the scene model, run the task,
+//! write `trace.csv`, `summary.json` and `frames.bin`.
+
+use super::runner::RunReport;
+use super::scenario::PickPlaceScenario;
+use super::session::Session;
+use super::summary::RunSummary;
+use super::trace::TraceWriter;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use tendril_cell::Cell;
+use tendril_twin::physics::{SceneModel, SceneSpec};
+
+/// Compiled scene models, shared between runs whose scenes are identical (a gain sweep
+/// compiles the model once per object). `MjModel` is `Send + Sync`; each run has its own data.
+#[derive(Default)]
+pub struct ModelCache {
+    models: Mutex<Vec<(SceneSpec, Arc<SceneModel>)>>,
+}
+
+impl ModelCache {
+    /// The model for `spec`, compiled on first use.
+    pub fn get(&self, spec: &SceneSpec) -> anyhow::Result<Arc<SceneModel>> {
+        let mut models = self.models.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some((_, m)) = models.iter().find(|(s, _)| s == spec) {
+            return Ok(m.clone());
+        }
+        let model = SceneModel::build(spec)?;
+        models.push((spec.clone(), model.clone()));
+        Ok(model)
+    }
+}
+
+/// Runs `scenario` on the twin. With `out`, writes `trace.csv` (streamed, kept on failure),
+/// `summary.json`, `scenario.toml` and `frames.bin` (the scene's state in MuJoCo's layout at
+/// 30 frames/s of cell time, for `tendril render`) there. A physics failure is an `error` outcome
+/// in the summary, not an `Err`; `Err` is for what prevents the run from starting (scene does not
+/// compile, folder not writable).
+pub fn run_on_twin(
+    scenario: &PickPlaceScenario,
+    models: &ModelCache,
+    out: Option<&Path>,
+) -> anyhow::Result<(RunSummary, RunReport)> {
+    let started = super::clock::RunClock::start();
+    // Warnings left on this thread by an earlier run are not this run's.
+    let _ = tendril_twin::mujoco_log::take_warnings();
+    let mut cell = scenario.sim_cell(models.get(&scenario.scene_spec())?);
+    if out.is_some() {
+        cell.record_frames(tendril_twin::frames::RECORD_FPS);
+    }
+    let result = run_on_cell(&mut cell, scenario, out, started);
+    // The frames too when the run failed to write a file: they show what happened.
+    if let (Some(dir), Some(frames)) = (out, cell.take_frames())
+        && let Err(e) = frames.write(&dir.join(tendril_twin::frames::FRAMES_FILE))
+    {
+        return Err(match result {
+            Ok(_) => anyhow::anyhow!("{e}: cannot write"),
+            Err(first) => anyhow::anyhow!("{first:#}; {e}: cannot write"),
+        });
+    }
+    result
+}
+
+/// Runs `scenario` on any cell, writing `trace.csv` and `summary.json` into `out` when given;
+/// the summary names the cell's backend. `started` is when the run's set-up began (its wall and CPU
+/// time count from there).
+pub fn run_on_cell(
+    cell: &mut dyn Cell,
+    scenario: &PickPlaceScenario,
+    out: Option<&Path>,
+    started: super::clock::RunClock,
+) -> anyhow::Result<(RunSummary, RunReport)> {
+    let trace = match out {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+            // Frames of an earlier run in this folder are not this run's (a run on the real cell
+            // records none; a twin run writes its own after the run).
+            let _ = std::fs::remove_file(dir.join(tendril_twin::frames::FRAMES_FILE));
+            let path = dir.join("trace.csv");
+            Some(TraceWriter::create(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?)
+        }
+        None => None,
+    };
+    let plan = scenario.control_plan();
+    let mut session = Session::start(&mut *cell, &plan, plan.controller.build(), trace);
+    session.run_to_end();
+    let (mut report, trace) = session.finish();
+    if let Some(push) = &scenario.disturbance.push {
+        let drop_time_s = report.drop.map(|d| d.cell_time_s);
+        report.metrics.max_fluctuation_outside_push_pct =
+            super::metrics::fluctuation_outside_push_pct(&report.rows, drop_time_s, push);
+    }
+    let mut summary =
+        RunSummary::new(scenario.identity(cell.backend()), &report, started.wall_s(), started.thread_cpu_s());
+    // The run's own thread stepped its physics (and compiled its model, if not cached).
+    summary.warnings = tendril_twin::mujoco_log::take_warnings();
+    if let Some(dir) = out {
+        // Every file is attempted, and every failure is reported: a trace that could not be
+        // written is an error even when summary.json could be.
+        let mut failures = Vec::new();
+        if let Some(e) = trace.as_ref().and_then(TraceWriter::error) {
+            failures.push(format!("{}: cannot write: {e}", dir.join("trace.csv").display()));
+        }
+        if let Err(e) = write_summary(dir, &summary, scenario) {
+            failures.push(format!("{e:#}"));
+        }
+        if !failures.is_empty() {
+            anyhow::bail!("{}", failures.join("; "));
+        }
+    }
+    Ok((summary, report))
+}
+
+/// Writes `summary.json` with the effective scenario under `"effective_scenario"` (every key after the
+/// defaults, the file and the `--set` overrides: what tools read to know the timestep, links,
+/// gains... a run used), and that scenario again as `scenario.toml`, which `tendril run` takes
+/// as it is to repeat the run from its own directory.
+pub fn write_summary(dir: &Path, summary: &RunSummary, scenario: &PickPlaceScenario) -> anyhow::Result<()> {
+    let mut record = serde_json::to_value(summary)?;
+    if let serde_json::Value::Object(fields) = &mut record {
+        fields.insert("effective_scenario".into(), serde_json::to_value(scenario)?);
+    }
+    // Atomically: a failed write (a full disk) keeps the previous file whole.
+    let write = |path: &Path, text: &str| {
+        tendril_config::write_atomically(path, text.as_bytes())
+            .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
+    };
+    write(&dir.join("summary.json"), &(serde_json::to_string_pretty(&record)? + "\n"))?;
+    let path = dir.join("scenario.toml");
+    let text = toml::to_string(scenario).map_err(|e| anyhow::anyhow!("{}: cannot encode: {e}", path.display()))?;
+    write(
+        &path,
+        &format!(
+            "# The effective scenario of this run (defaults, file and --set applied): `tendril run` repeats it.\n{text}"
+        ),
+    )
+}

@@ -1,0 +1,19 @@
+#![doc = include_str!("../README.md")]
+#![warn(missing_docs)]
+
+mod backend_defaults;
+pub mod clock;
+pub mod compare;
+pub mod drop_watch;
+pub mod execute;
+pub mod metrics;
+pub mod output;
+mod paths;
+pub mod plan;
+pub mod real;
+pub mod report;
+pub mod runner;
+pub mod scenario;
+pub mod session;
+pub mod summary;
+pub mod trace;

@@ -1,0 +1,21 @@
+#![doc = include_str!("../README.md")]
+#![warn(missing_docs)]
+
+mod bus;
+pub mod config;
+pub mod controller;
+pub mod dashboard;
+mod handle;
+pub mod io;
+pub mod jitter;
+mod net;
+pub mod program;
+mod setpoint;
+pub mod state;
+mod twin;
+
+pub use config::{IDLE_TIMEOUT, ServeConfig, UrAddrs};
+pub use controller::{UrController, VirtualUrSetup};
+pub use handle::{ServeHandle, start};
+pub use jitter::{Jitter, JitterModel, JitterProfile};
+pub use state::{DeviceState, ProgramState, TwinStatus};

@@ -1,0 +1,300 @@
+//! The virtual controller's program: the URScript interpreter run in the twin's time, its RTDE
+//! watchdog, and the hand-over of its arm setpoints to the safety check.
+//!
+//! Life cycle ([`DeviceState::program`]): a complete program on 30002/30003 is parsed and plays
+//! from its first line (a syntax error is logged and the program does not start); dashboard
+//! `play` after `stop`, or after `load X.urp`, starts the current program afresh (a `.urp` is the
+//! follow program, [`FOLLOW_SCRIPT`]); `pause` holds the interpreter, `play` resumes it. The program
+//! ends when its body ends, on a runtime error (logged with its line), a protective stop, its
+//! RTDE watchdog ("stop"), the dashboard's `stop` or the robot leaving RUNNING. When it ends the
+//! output registers it wrote are cleared (our choice: a client polling `output_int_register_24`
+//! then sees the program is not following).
+//!
+//! The interpreter runs one 2 ms controller cycle whenever the twin's clock has reached the next
+//! cycle (the twin ticks every 1 ms by default), in twin time, so a twin held up by a busy
+//! machine never makes a program see time pass that the arm did not.
+
+use super::state::{DeviceState, ProgramState};
+use std::collections::VecDeque;
+use tendril_rtde::dashboard::RobotMode;
+use tendril_urscript::interp::CONTROL_PERIOD_S;
+use tendril_urscript::{Controller, DigitalOut, FOLLOW_SCRIPT, Interpreter, RtdeWatchdog, Status, WatchdogAction};
+
+/// Lines kept in [`DeviceState::program_log`].
+pub const LOG_LINES: usize = 500;
+
+/// What the arm should do this twin tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ArmCommand {
+    /// Keep the last command.
+    Keep,
+    /// A `servoj` target: joint angles \[rad\] given by the program's cycle at twin time `at_s`
+    /// \[s\]. The twin's arm passes through each target at a fixed delay after its cycle, moving
+    /// linearly from one target to the next (see the twin's `ServoPath`), whatever its physics step.
+    Servo {
+        /// Target \[rad\].
+        q: [f64; 6],
+        /// The program cycle that gave it \[s\].
+        at_s: f64,
+    },
+    /// Follow a generated trajectory: the setpoint `q` \[rad\] at twin time `at_s` \[s\] moving at
+    /// `qd` \[rad/s\]. The twin commands the setpoint extrapolated to the end of each physics step:
+    /// commanding every 2 ms cycle against 5 ms physics steps would move the arm by two cycles'
+    /// way in some steps and three in others (`actual_qd` alternating between 0.8 and 1.2 times
+    /// the speed).
+    Track {
+        /// Setpoint \[rad\].
+        q: [f64; 6],
+        /// Its speed \[rad/s\].
+        qd: [f64; 6],
+        /// Its time \[s\].
+        at_s: f64,
+    },
+    /// Stop where the arm is (the program stopped or a protective stop).
+    Hold,
+}
+
+/// The program runner the twin thread owns.
+#[derive(Debug, Default)]
+pub struct ProgramRunner {
+    interpreter: Option<Interpreter>,
+    uploads_seen: u64,
+    /// The armed watchdog: variable, its write count and when that last changed (twin time).
+    armed: Option<(String, u64, f64)>,
+    next_cycle_s: f64,
+}
+
+/// The interpreter's view of the devices' state.
+struct Host<'a> {
+    s: &'a mut DeviceState,
+    measured_q: [f64; 6],
+    watchdog_set: bool,
+}
+
+impl Controller for Host<'_> {
+    fn input_int(&self, i: usize) -> i32 {
+        self.s.inputs.values.int_registers[i]
+    }
+    fn input_float(&self, i: usize) -> f64 {
+        self.s.inputs.values.double_registers[i]
+    }
+    fn input_bool(&self, i: usize) -> bool {
+        self.s.inputs.values.bit_registers >> i & 1 == 1
+    }
+    fn set_output_int(&mut self, i: usize, v: i32) {
+        self.s.outputs.int_registers[i] = v;
+    }
+    fn set_output_float(&mut self, i: usize, v: f64) {
+        self.s.outputs.double_registers[i] = v;
+    }
+    fn set_output_bool(&mut self, i: usize, v: bool) {
+        let bit = 1u128 << i;
+        let bits = &mut self.s.outputs.bit_registers;
+        *bits = if v { *bits | bit } else { *bits & !bit };
+    }
+    fn set_digital_out(&mut self, kind: DigitalOut, i: usize, v: bool) {
+        super::io::set_digital_out(&mut self.s.outputs, kind, i, v);
+    }
+    fn set_analog_out(&mut self, i: usize, v: f64) {
+        super::io::set_analog_out(&mut self.s.outputs, i, v);
+    }
+    fn actual_q(&self) -> [f64; 6] {
+        self.measured_q
+    }
+    fn input_packages(&self) -> u64 {
+        self.s.inputs.packages
+    }
+    fn set_watchdog(&mut self, watchdog: RtdeWatchdog) {
+        self.s.watchdog = Some(watchdog);
+        self.watchdog_set = true;
+    }
+    fn message(&mut self, text: &str) {
+        log(&mut self.s.program_log, text);
+    }
+}
+
+fn log(lines: &mut VecDeque<String>, text: &str) {
+    if lines.len() >= LOG_LINES {
+        lines.pop_front();
+    }
+    lines.push_back(text.to_string());
+}
+
+impl ProgramRunner {
+    /// One twin tick at `now_s` \[s\] with the arm measured at `measured_q`: starts, steps, pauses
+    /// or ends the program and returns what the arm should do.
+    pub fn tick(&mut self, s: &mut DeviceState, now_s: f64, measured_q: [f64; 6]) -> ArmCommand {
+        let mut hold = false;
+        // A new upload replaces the running program. The script port set it playing when it
+        // arrived; a dashboard `pause`, `stop` or `power off` since then stands (setting it
+        // playing here again, a tick late, restarted programs the dashboard had stopped).
+        if s.program_uploads != self.uploads_seen {
+            self.uploads_seen = s.program_uploads;
+            self.end(s);
+        }
+        // Powered off or brakes engaged (dashboard): no program runs, the arm holds.
+        if s.ur.robot_mode != RobotMode::Running && s.program != ProgramState::Stopped {
+            s.program = ProgramState::Stopped;
+            hold = true;
+        }
+        if s.program == ProgramState::Playing && self.interpreter.is_none() {
+            self.start(s, now_s, measured_q);
+        }
+        hold |= self.check_watchdog(s, now_s);
+        if s.program == ProgramState::Stopped {
+            if self.interpreter.is_some() {
+                self.end(s);
+                hold = true;
+            }
+            return if hold { ArmCommand::Hold } else { ArmCommand::Keep };
+        }
+        if s.program == ProgramState::Paused || now_s + 1e-9 < self.next_cycle_s {
+            return if hold { ArmCommand::Hold } else { ArmCommand::Keep };
+        }
+        let cycle_s = self.next_cycle_s;
+        // A twin that fell behind by more than a cycle resumes the schedule from now.
+        self.next_cycle_s = if cycle_s + CONTROL_PERIOD_S < now_s { now_s } else { cycle_s } + CONTROL_PERIOD_S;
+        let Some(interpreter) = self.interpreter.as_mut() else { return ArmCommand::Keep };
+        let mut host = Host { s, measured_q, watchdog_set: false };
+        let command = interpreter.step(cycle_s, &mut host);
+        let (servoing, qd) = (interpreter.servoing(), interpreter.target_qd());
+        let watchdog_set = host.watchdog_set;
+        let status = interpreter.status().clone();
+        if watchdog_set {
+            self.arm_watchdog(s, now_s);
+        }
+        match status {
+            Status::Running => {}
+            Status::Finished => {
+                log(&mut s.program_log, "program finished");
+                s.program = ProgramState::Stopped;
+                self.end(s);
+                return ArmCommand::Keep;
+            }
+            Status::Failed(e) => {
+                eprintln!("virtual UR5e: program stopped: {e}");
+                s.program = ProgramState::Stopped;
+                self.end(s);
+                return ArmCommand::Hold;
+            }
+        }
+        let Some(q) = command else { return ArmCommand::Keep };
+        match tendril_ur5e::safety::violation(&q, &measured_q) {
+            None if servoing => ArmCommand::Servo { q, at_s: cycle_s },
+            None => ArmCommand::Track { q, qd, at_s: cycle_s },
+            Some(why) => {
+                // Protective stop: the arm stops where it is, the program stops.
+                log(&mut s.program_log, &format!("protective stop: {why}"));
+                s.protective_stop = Some(why);
+                s.ur.protective_stop_at = Some(now_s);
+                s.program = ProgramState::Stopped;
+                self.end(s);
+                ArmCommand::Hold
+            }
+        }
+    }
+
+    fn start(&mut self, s: &mut DeviceState, now_s: f64, measured_q: [f64; 6]) {
+        let source = s.program_source.clone().unwrap_or_else(|| FOLLOW_SCRIPT.to_string());
+        match Interpreter::new(&source, measured_q) {
+            Ok(i) => {
+                self.interpreter = Some(i);
+                self.next_cycle_s = now_s;
+            }
+            Err(e) => {
+                let line = format!("syntax error, program not started: {e}");
+                eprintln!("virtual UR5e: {line}");
+                log(&mut s.program_log, &line);
+                s.program = ProgramState::Stopped;
+            }
+        }
+    }
+
+    /// Drops the interpreter and what it set: watchdog, output registers.
+    fn end(&mut self, s: &mut DeviceState) {
+        if self.interpreter.take().is_some() {
+            let o = &mut s.outputs;
+            o.int_registers.fill(0);
+            o.double_registers.fill(0.0);
+            o.bit_registers = 0;
+        }
+        self.armed = None;
+        s.watchdog = None;
+    }
+
+    fn arm_watchdog(&mut self, s: &DeviceState, now_s: f64) {
+        let Some(w) = &s.watchdog else { return };
+        if self.armed.as_ref().is_none_or(|(v, ..)| *v != w.variable) {
+            self.armed = Some((w.variable.clone(), s.inputs.writes_of(&w.variable), now_s));
+        }
+    }
+
+    /// `rtde_set_watchdog`: whether it just stopped or paused the program (the arm then holds).
+    fn check_watchdog(&mut self, s: &mut DeviceState, now_s: f64) -> bool {
+        if s.program != ProgramState::Playing {
+            return false;
+        }
+        let (Some(w), Some((variable, seen, at))) = (&s.watchdog, &mut self.armed) else { return false };
+        let writes = s.inputs.writes_of(variable);
+        if writes != *seen {
+            (*seen, *at) = (writes, now_s);
+            return false;
+        }
+        if now_s - *at <= 1.0 / w.min_frequency_hz {
+            return false;
+        }
+        match w.action {
+            WatchdogAction::Ignore => false,
+            WatchdogAction::Pause => {
+                s.program = ProgramState::Paused;
+                true
+            }
+            WatchdogAction::Stop => {
+                s.program = ProgramState::Stopped;
+                true
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::controller::VirtualUrSetup;
+    use tendril_drivers::HardwareConfig;
+    use tendril_fbg::SpectralConfig;
+
+    /// What `serve_script` does when a complete program arrives.
+    fn upload(s: &mut DeviceState) {
+        s.program_source = Some(FOLLOW_SCRIPT.to_string());
+        s.program_uploads += 1;
+        s.program = ProgramState::Playing;
+    }
+
+    #[test]
+    fn a_dashboard_stop_before_the_twin_sees_an_upload_stands() {
+        let (state, _) = crate::state::shared_state(
+            &HardwareConfig::default(),
+            &SpectralConfig::default(),
+            &VirtualUrSetup::default(),
+        )
+        .unwrap();
+        let mut s = state.lock().unwrap();
+        let mut runner = ProgramRunner::default();
+        upload(&mut s);
+        // The dashboard stops it before the twin's next tick (a delayed twin thread).
+        s.program = ProgramState::Stopped;
+        runner.tick(&mut s, 0.0, [0.0; 6]);
+        assert_eq!(s.program, ProgramState::Stopped, "the stop stands");
+        // Played again, it runs the uploaded program.
+        s.program = ProgramState::Playing;
+        runner.tick(&mut s, 0.002, [0.0; 6]);
+        assert_eq!(s.program, ProgramState::Playing);
+        assert!(runner.interpreter.is_some(), "the program started");
+        // A second upload replaces it and plays.
+        upload(&mut s);
+        runner.tick(&mut s, 0.004, [0.0; 6]);
+        assert_eq!(s.program, ProgramState::Playing);
+        assert_eq!(runner.uploads_seen, 2);
+    }
+}

@@ -1,0 +1,40 @@
+//! The physics of the cell: UR5e, grow-and-twine finger with the FBG sensor pad, one of the paper's
+//! objects and the table, assembled from models/ for what a scenario needs and simulated by MuJoCo or
+//! rapier behind one [`Physics`] trait.
+//!
+//! - [`config`]: the `[physics]` (with `[physics.rapier]`), `[finger]` and `[object]` sections.
+//! - [`compose`]: MJCF assembly from the model files. MuJoCo compiles it into the [`SceneModel`],
+//!   the one description of the scene both backends start from.
+//! - [`scene`]: the MuJoCo run ([`Scene`]); [`rapier`]: the rapier world built from the compiled
+//!   model and its run ([`rapier::RapierScene`]).
+//! - [`drive`]: motor speed limits, the kinematic arm's interpolation and the grip-in-hand
+//!   readout, shared by both backends.
+//! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
+//! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
+//! - `spec.rs`: what a scene holds ([`SceneSpec`]); `engine.rs`: the [`Physics`] trait; `start.rs`: a run
+//!   on a model ([`SceneModel::start`]).
+
+pub mod check;
+pub mod compose;
+pub mod config;
+pub mod drive;
+mod engine;
+mod error;
+pub mod export;
+pub mod object;
+pub mod rapier;
+pub mod scene;
+mod spec;
+mod start;
+pub mod strip;
+pub mod template;
+pub mod validation;
+
+pub use compose::Placement;
+pub use config::{
+    ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig, Solver,
+};
+pub use engine::Physics;
+pub use error::{Divergence, PhysicsError};
+pub use scene::{PhysicsReadout, Scene, SceneModel};
+pub use spec::SceneSpec;

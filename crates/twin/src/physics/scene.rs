@@ -1,0 +1,631 @@
+//! One simulation run of the cell: a compiled, shareable [`SceneModel`] and per-run [`Scene`] state.
+
+use super::compose::{self, Placement};
+use super::config::{ArmMode, Backend};
+use super::drive::{Drive, grip_in_hand};
+use super::{Divergence, Physics, PhysicsError, SceneSpec};
+use mujoco_rs::mujoco_c::{_mjtObjBase, mjtWarning};
+use mujoco_rs::prelude::{MjData, MjModel};
+use nalgebra::{Isometry3, Vector3};
+use std::sync::Arc;
+use tendril_config::{Checker, Validate};
+
+/// The quaternion (w, x, y, z) of a turn by `yaw_deg` about the vertical.
+pub(crate) fn yaw_quaternion(yaw_deg: f64) -> [f64; 4] {
+    let half = yaw_deg.to_radians() / 2.0;
+    [half.cos(), 0.0, 0.0, half.sin()]
+}
+
+/// A compiled scene model and the element ids the readout needs. Build it once and share it (it is
+/// `Send + Sync`) between many [`Scene`]s, for example across threads.
+#[derive(Debug)]
+pub struct SceneModel {
+    model: Arc<MjModel>,
+    spec: SceneSpec,
+    placement: Placement,
+    xml: String,
+    ids: Ids,
+}
+
+/// Ids of the elements the readout and the backends need (MuJoCo's numbering, which the rapier
+/// world keeps: it is built from the same compiled model).
+#[derive(Debug, Clone)]
+pub(crate) struct Ids {
+    /// Geoms of the sensor pad (casing, bump).
+    pub(crate) pad_geoms: Vec<usize>,
+    /// Geoms of the strip and the pad.
+    pub(crate) finger_geoms: Vec<usize>,
+    /// The palm beside the guide exit.
+    pub(crate) palm_geom: Vec<usize>,
+    /// Every geom the arm carries (its links, the hand, palm, strip and pad): what the object can
+    /// load the wrist through.
+    pub(crate) hand_geoms: Vec<usize>,
+    /// The object's geoms (empty without object).
+    pub(crate) object_geoms: Vec<usize>,
+    pub(crate) object_body: Option<usize>,
+    pub(crate) object_grip: Option<usize>,
+    pub(crate) object_qpos: Option<usize>,
+    pub(crate) hand_body: usize,
+    pub(crate) growth_qpos: usize,
+    pub(crate) twine_qpos: usize,
+    pub(crate) creep_qpos: usize,
+    pub(crate) growth_act: usize,
+    pub(crate) twine_act: usize,
+    /// Joints of the growth and twine outputs, the creep node and the arm.
+    pub(crate) growth_joint: usize,
+    pub(crate) twine_joint: usize,
+    pub(crate) creep_joint: usize,
+    pub(crate) arm_joint: [usize; 6],
+    pub(crate) arm_qpos: [usize; 6],
+    pub(crate) arm_dof: [usize; 6],
+    /// Servo actuators of the arm (dynamic mode only).
+    pub(crate) arm_act: Option<[usize; 6]>,
+    /// Each arm servo's velocity feedforward as a lead \[s\]: (kv + joint damping) / kp, so that a
+    /// setpoint moving at speed v is followed without the lag (kv + damping) v / kp a bare PD servo
+    /// has (dynamic mode; zero in the kinematic one).
+    pub(crate) arm_servo_lead_s: [f64; 6],
+    pub(crate) tendon_elastic: usize,
+    pub(crate) tendon_maxwell: usize,
+    pub(crate) pad_touch_adr: usize,
+}
+
+fn id(model: &MjModel, kind: _mjtObjBase, kind_name: &'static str, name: &str) -> Result<usize, PhysicsError> {
+    model.name_to_id(kind, name).ok_or_else(|| PhysicsError::Missing { kind: kind_name, name: name.to_string() })
+}
+
+impl SceneModel {
+    /// Validates `spec`, assembles the MJCF from models/, compiles it and applies the overrides that
+    /// edit the compiled model (object friction, start poses).
+    pub fn build(spec: &SceneSpec) -> Result<Arc<SceneModel>, PhysicsError> {
+        let mut checker = Checker::default();
+        spec.validate(&mut checker);
+        if let Some((key, reason)) = checker.into_first_error() {
+            return Err(PhysicsError::Config { key, reason });
+        }
+        let (xml, placement) = compose::scene(spec)?;
+        let mut model =
+            MjModel::from_xml_string(&xml).map_err(|e| PhysicsError::Compile { message: format!("{e:?}") })?;
+        let ids = Self::find_ids(&model, spec)?;
+
+        // Object: friction override on the grip the finger touches (its base keeps its own friction
+        // against the table), start pose on the table.
+        if let Some(obj) = &spec.object {
+            if let (Some(mu), Some(g)) = (obj.friction, ids.object_grip) {
+                model.geom_friction_mut()[g][0] = mu;
+            }
+            if let (Some(adr), Some(p)) = (ids.object_qpos, placement.object) {
+                let [w, x, y, z] = yaw_quaternion(obj.yaw_deg.unwrap_or(0.0));
+                model.qpos0_mut()[adr..adr + 7].copy_from_slice(&[p.x, p.y, p.z, w, x, y, z]);
+            }
+            if let (Some(mass), Some(body)) = (obj.mass_kg, ids.object_body) {
+                // Same shape and mass distribution: the inertia scales with the mass.
+                let scale = mass / model.body_mass()[body];
+                model.body_mass_mut()[body] = mass;
+                for v in model.body_inertia_mut()[body].iter_mut() {
+                    *v *= scale;
+                }
+                // The constants MuJoCo derives from masses (subtree masses, the inverse weights its
+                // contact softness is scaled by) follow the new mass, as the compiler would set them.
+                MjData::new(&mut model).set_const();
+            }
+        }
+        if spec.physics.arm_mode == ArmMode::Kinematic {
+            // Prescribed motion: the arm must not give way to contact forces within a step.
+            for d in ids.arm_dof {
+                model.dof_armature_mut()[d] = KINEMATIC_ARM_ARMATURE;
+            }
+        }
+        let shared = Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids });
+        if spec.physics.backend == Backend::Rapier {
+            // Translate once now, so an element rapier cannot take is an error before any run starts.
+            super::rapier::RapierScene::new(shared.clone())?;
+        }
+        Ok(shared)
+    }
+
+    fn find_ids(m: &MjModel, spec: &SceneSpec) -> Result<Ids, PhysicsError> {
+        use _mjtObjBase::*;
+        let geom = |n: &str| id(m, mjOBJ_GEOM, "geom", n);
+        let joint = |n: &str| id(m, mjOBJ_JOINT, "joint", n);
+        let qpos = |n: &str| joint(n).map(|j| m.jnt_qposadr()[j] as usize);
+        let act = |n: &str| id(m, mjOBJ_ACTUATOR, "actuator", n);
+        let pad_geoms = vec![geom("pad_casing")?, geom("pad_bump")?];
+        let mut finger_geoms = pad_geoms.clone();
+        for i in 0..super::strip::layout(&spec.finger).len() {
+            finger_geoms.push(geom(&format!("seg{i}"))?);
+        }
+        let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() {
+            let body = id(m, mjOBJ_BODY, "body", "object")?;
+            let geoms = (0..m.ffi().ngeom as usize).filter(|&g| m.geom_bodyid()[g] as usize == body).collect();
+            (geoms, Some(body), Some(geom("object_grip")?), Some(qpos("object")?))
+        } else {
+            (Vec::new(), None, None, None)
+        };
+        let hand_body = id(m, mjOBJ_BODY, "body", "hand")?;
+        let arm_root = m.body_rootid()[hand_body];
+        let hand_geoms =
+            (0..m.ffi().ngeom as usize).filter(|&g| m.body_rootid()[m.geom_bodyid()[g] as usize] == arm_root).collect();
+        let names = ["shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"];
+        let mut arm_qpos = [0; 6];
+        let mut arm_dof = [0; 6];
+        let mut arm_joint = [0; 6];
+        for k in 0..6 {
+            arm_joint[k] = joint(names[k])?;
+            arm_qpos[k] = qpos(names[k])?;
+            arm_dof[k] = m.jnt_dofadr()[arm_joint[k]] as usize;
+        }
+        let arm_act = match spec.physics.arm_mode {
+            ArmMode::Kinematic => None,
+            ArmMode::Dynamic => {
+                let mut a = [0; 6];
+                for k in 0..6 {
+                    a[k] = act(names[k])?;
+                }
+                Some(a)
+            }
+        };
+        // A position actuator's force is kp (ctrl - q) - kv dq/dt (MuJoCo: gainprm[0] = kp,
+        // biasprm[2] = -kv), and the joint's damping adds -d dq/dt.
+        let arm_servo_lead_s = match arm_act {
+            None => [0.0; 6],
+            Some(a) => std::array::from_fn(|k| {
+                let (kp, kv) = (m.actuator_gainprm()[a[k]][0], -m.actuator_biasprm()[a[k]][2]);
+                if kp > 0.0 { (kv + m.dof_damping()[arm_dof[k]]) / kp } else { 0.0 }
+            }),
+        };
+        let touch = id(m, mjOBJ_SENSOR, "sensor", "pad_touch")?;
+        Ok(Ids {
+            pad_geoms,
+            finger_geoms,
+            palm_geom: vec![geom("palm")?],
+            hand_geoms,
+            object_geoms,
+            object_body,
+            object_grip,
+            object_qpos,
+            hand_body,
+            growth_qpos: qpos("growth")?,
+            twine_qpos: qpos("twine")?,
+            creep_qpos: qpos("creep")?,
+            growth_act: act("growth")?,
+            growth_joint: joint("growth")?,
+            twine_joint: joint("twine")?,
+            creep_joint: joint("creep")?,
+            arm_joint,
+            twine_act: act("twine")?,
+            arm_qpos,
+            arm_dof,
+            arm_act,
+            arm_servo_lead_s,
+            tendon_elastic: id(m, mjOBJ_TENDON, "tendon", "tendon_elastic")?,
+            tendon_maxwell: id(m, mjOBJ_TENDON, "tendon", "tendon_maxwell")?,
+            pad_touch_adr: m.sensor_adr()[touch] as usize,
+        })
+    }
+
+    /// The compiled MuJoCo model.
+    pub fn model(&self) -> &Arc<MjModel> {
+        &self.model
+    }
+
+    /// The spec it was built from.
+    pub fn spec(&self) -> &SceneSpec {
+        &self.spec
+    }
+
+    /// Where the parts start (hand pose, object footprint, table height).
+    pub fn placement(&self) -> &Placement {
+        &self.placement
+    }
+
+    /// Element ids for the backends.
+    pub(crate) fn ids(&self) -> &Ids {
+        &self.ids
+    }
+
+    /// The sensor pad's geoms (casing, bump), in MuJoCo's numbering (for a renderer to colour).
+    pub fn pad_geoms(&self) -> &[usize] {
+        &self.ids.pad_geoms
+    }
+
+    /// The object's grip geom, if the scene has an object (where a camera may look).
+    pub fn object_grip_geom(&self) -> Option<usize> {
+        self.ids.object_grip
+    }
+
+    /// The hand's body (the flange frame).
+    pub fn hand_body(&self) -> usize {
+        self.ids.hand_body
+    }
+
+    /// The assembled MJCF text (for inspection or saving).
+    pub fn xml(&self) -> &str {
+        &self.xml
+    }
+}
+
+/// What the physics reports after a step (SI units, world frame).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PhysicsReadout {
+    /// Simulated time \[s\].
+    pub time_s: f64,
+    /// Normal force of the object on the sensor pad (casing and bump) \[N\]: the FBG sensor's input.
+    pub pad_force_n: f64,
+    /// Sum of the normal forces between the object and the whole finger, pad included \[N\].
+    pub grip_force_n: f64,
+    /// Normal force between the object and the palm beside the guide exit \[N\] (not part of the grip
+    /// force: the palm is the hand, not the finger).
+    pub palm_force_n: f64,
+    /// Number of active object-finger contacts.
+    pub grip_contacts: usize,
+    /// Whether the object touches the finger at all.
+    pub touching: bool,
+    /// Object body origin (footprint centre) \[m\].
+    pub object_pos_m: [f64; 3],
+    /// Object orientation (w, x, y, z).
+    pub object_quat: [f64; 4],
+    /// Linear velocity of the object's grip centre (the middle of the wrapped handle or neck) [m/s].
+    pub object_vel_m_s: [f64; 3],
+    /// The object's grip centre expressed in the hand frame \[m\]: its change is the slip distance (hand z
+    /// points down in the pick pose, so a falling object's z grows).
+    pub object_in_hand_m: [f64; 3],
+    /// Speed of the object's grip centre relative to the hand point it coincides with [m/s].
+    pub slip_speed_m_s: f64,
+    /// Hand (flange) position \[m\].
+    pub hand_pos_m: [f64; 3],
+    /// Finger growth out of the guide \[m\] (actual motor position).
+    pub growth_m: f64,
+    /// Tendon wound in by the twine motor \[m\] (actual motor position).
+    pub twine_m: f64,
+    /// The twine servo's current setpoint \[m\] (the command after the motor speed limit).
+    pub twine_setpoint_m: f64,
+    /// Creep elongation of the Maxwell branch \[m\].
+    pub creep_m: f64,
+    /// Tendon tension, both branches \[N\].
+    pub tendon_tension_n: f64,
+    /// Arm joint angles \[rad\] (kinematic mode: the rate-limited commanded angles).
+    pub arm_q: [f64; 6],
+    /// The object's vertical load on the arm \[N\]: the upward (world +z) component of every
+    /// contact force the arm and what it carries (links, hand, palm, strip, pad) exert on the
+    /// object, so an object hanging still in the grip reads its weight. What the arm's wrist force
+    /// sensor adds to the tool's own load ([`crate::wrist`]). MuJoCo sums its contact forces;
+    /// rapier, whose friction impulses stay inside its solver, takes it from the object's momentum
+    /// over the step. `None` where a backend cannot tell it.
+    pub tool_load_n: Option<f64>,
+}
+
+/// One MuJoCo simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a
+/// bit-identical trajectory.
+#[derive(Debug)]
+pub struct Scene {
+    shared: Arc<SceneModel>,
+    data: MjData<Arc<MjModel>>,
+    drive: Drive,
+    warnings_seen: [i32; 8],
+    /// The hand subtree's centre-of-mass Jacobian (3 x nv, row-major), reused every step.
+    payload_jacobian: Vec<f64>,
+}
+
+/// Armature of the arm joints in the kinematic mode [kg m^2]: large enough that a few newtons of
+/// contact force do not turn a joint within a step (their motion is prescribed anyway).
+pub(crate) const KINEMATIC_ARM_ARMATURE: f64 = 1000.0;
+
+/// MuJoCo warnings that mean the run is not trustworthy.
+const FATAL_WARNINGS: [(mjtWarning, &str); 6] = [
+    (mjtWarning::mjWARN_INERTIA, "bad inertia"),
+    (mjtWarning::mjWARN_CONTACTFULL, "contact buffer full"),
+    (mjtWarning::mjWARN_CNSTRFULL, "constraint buffer full"),
+    (mjtWarning::mjWARN_BADQPOS, "bad qpos (NaN/Inf/huge)"),
+    (mjtWarning::mjWARN_BADQVEL, "bad qvel (NaN/Inf/huge)"),
+    (mjtWarning::mjWARN_BADQACC, "bad qacc (NaN/Inf/huge): unstable"),
+];
+
+impl Scene {
+    /// Builds the model for `spec` and a run on it.
+    pub fn build(spec: &SceneSpec) -> Result<Scene, PhysicsError> {
+        Ok(Scene::new(SceneModel::build(spec)?))
+    }
+
+    /// A fresh run on a shared model, at the start placement with the finger retracted and slack.
+    pub fn new(shared: Arc<SceneModel>) -> Scene {
+        let mut data = MjData::new(shared.model.clone());
+        let q0 = shared.spec.arm_q0;
+        // Hinge angles count from qpos0 (the model's zero pose), so the start pose is set in the data,
+        // not in the model; the object's free joint starts from its qpos0 set in SceneModel::build.
+        for (adr, q) in shared.ids.arm_qpos.iter().zip(q0) {
+            data.qpos_mut()[*adr] = q;
+        }
+        if let Some(acts) = shared.ids.arm_act {
+            for (a, q) in acts.iter().zip(q0) {
+                data.ctrl_mut()[*a] = q;
+            }
+        }
+        data.forward();
+        let drive = Drive::new(&shared.spec.physics, &shared.spec.finger, q0);
+        let payload_jacobian = vec![0.0; 3 * shared.model.ffi().nv as usize];
+        Scene { shared, data, drive, warnings_seen: [0; 8], payload_jacobian }
+    }
+
+    /// The shared model.
+    pub fn shared(&self) -> &Arc<SceneModel> {
+        &self.shared
+    }
+
+    /// Raw MuJoCo data (read-only), for checks beyond the readout.
+    pub fn data(&self) -> &MjData<Arc<MjModel>> {
+        &self.data
+    }
+
+    /// The servoed arm's payload compensation, as a UR's controller has for its configured payload:
+    /// the joint torques that carry the weight of the hand and everything on it (the finger, the
+    /// pad; not a held object), from the subtree's centre-of-mass Jacobian at the last computed
+    /// pose. Without it the position servos sagged under that weight (1.5 mrad at the shoulder,
+    /// about 1.2 mm at the hand), where a UR holds its pose to a fraction of that.
+    fn compensate_payload(&mut self) {
+        let ids = &self.shared.ids;
+        let model = &self.shared.model;
+        let nv = model.ffi().nv as usize;
+        let mass = model.body_subtreemass()[ids.hand_body];
+        let gravity = model.opt().gravity;
+        self.data.jac_subtree_com_into(ids.hand_body, &mut self.payload_jacobian);
+        for d in ids.arm_dof {
+            let along_gravity: f64 = (0..3).map(|i| self.payload_jacobian[i * nv + d] * gravity[i]).sum();
+            self.data.qfrc_applied_mut()[d] = -mass * along_gravity;
+        }
+    }
+
+    fn check(&mut self, time_s: f64) -> Result<(), PhysicsError> {
+        let diverged = |cause| Err(PhysicsError::Diverged { time_s, cause });
+        // Warnings first: on a bad acceleration MuJoCo resets the state, so the NaN is gone by now.
+        let warnings = self.data.warning();
+        for (k, (w, name)) in FATAL_WARNINGS.iter().enumerate() {
+            let count = warnings[*w as usize].number;
+            if count > self.warnings_seen[k] {
+                self.warnings_seen[k] = count;
+                return diverged(Divergence::Warning { warning: name });
+            }
+        }
+        for (what, values) in [("qpos", self.data.qpos()), ("qvel", self.data.qvel()), ("qacc", self.data.qacc())] {
+            if values.iter().any(|v| !v.is_finite()) {
+                return diverged(Divergence::NonFinite { what });
+            }
+        }
+        let bound = self.shared.spec.physics.max_penetration_m;
+        for c in self.data.contact() {
+            if c.dist < -bound {
+                let name = |g: i32| {
+                    self.shared.model.id_to_name(_mjtObjBase::mjOBJ_GEOM, g as usize).unwrap_or("?").to_string()
+                };
+                return diverged(Divergence::Penetration {
+                    depth_m: -c.dist,
+                    geom1: name(c.geom1),
+                    geom2: name(c.geom2),
+                });
+            }
+        }
+        // Kinetic energy of what is simulated: the kinematic arm's armature term is prescribed motion.
+        let mut kinetic = self.data.energy()[1];
+        if self.shared.ids.arm_act.is_none() {
+            for d in self.shared.ids.arm_dof {
+                kinetic -= 0.5 * KINEMATIC_ARM_ARMATURE * self.data.qvel()[d].powi(2);
+            }
+        }
+        if !kinetic.is_finite() || kinetic > self.shared.spec.physics.max_kinetic_energy_j {
+            return diverged(Divergence::Energy { joules: kinetic });
+        }
+        Ok(())
+    }
+
+    /// Normal force \[N\] summed over contacts between a geom in `a` and a geom in `b`, and their count.
+    pub fn normal_force_between(&self, a: &[usize], b: &[usize]) -> (f64, usize) {
+        let mut sum = 0.0;
+        let mut n = 0;
+        for (i, c) in self.data.contact().iter().enumerate() {
+            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+            let hit = (a.contains(&g1) && b.contains(&g2)) || (a.contains(&g2) && b.contains(&g1));
+            if hit && c.efc_address >= 0 {
+                sum += self.data.contact_force(i)[0];
+                n += 1;
+            }
+        }
+        (sum, n)
+    }
+
+    /// The upward (world +z) component of the contact forces geoms `a` exert on geoms `b` \[N\].
+    pub fn vertical_force_on(&self, a: &[usize], b: &[usize]) -> f64 {
+        let mut up = 0.0;
+        for (i, c) in self.data.contact().iter().enumerate() {
+            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+            // MuJoCo's contact frame: rows normal, tangent 1, tangent 2; the normal points from
+            // geom1 to geom2, and the force in that frame is the one geom1 exerts on geom2.
+            let sign = if a.contains(&g1) && b.contains(&g2) {
+                1.0
+            } else if a.contains(&g2) && b.contains(&g1) {
+                -1.0
+            } else {
+                continue;
+            };
+            if c.efc_address >= 0 {
+                let f = self.data.contact_force(i);
+                let z = f[0] * c.frame[2] + f[1] * c.frame[5] + f[2] * c.frame[8];
+                up += sign * z;
+            }
+        }
+        up
+    }
+
+    /// The pad's normal force as MuJoCo's `touch` sensor on `pad_site` reports it \[N\].
+    pub fn pad_touch_sensor_n(&self) -> f64 {
+        self.data.sensordata()[self.shared.ids.pad_touch_adr]
+    }
+
+    /// Tension of the tendon path \[N\]: both standard-linear-solid branches (zero when slack).
+    pub fn tendon_tension_n(&self) -> f64 {
+        let ids = &self.shared.ids;
+        let m = &self.shared.model;
+        let len = self.data.ten_length();
+        let k = m.tendon_stiffness();
+        // Length below the dead band's lower end (0) stretches the tendon.
+        (-len[ids.tendon_elastic]).max(0.0) * k[ids.tendon_elastic]
+            + (-len[ids.tendon_maxwell]).max(0.0) * k[ids.tendon_maxwell]
+    }
+
+    /// Geom ids of the sensor pad (casing, bump).
+    pub fn pad_geoms(&self) -> &[usize] {
+        &self.shared.ids.pad_geoms
+    }
+
+    /// Geom ids of the object.
+    pub fn object_geoms(&self) -> &[usize] {
+        &self.shared.ids.object_geoms
+    }
+}
+
+impl Physics for Scene {
+    fn backend(&self) -> Backend {
+        Backend::Mujoco
+    }
+
+    fn time(&self) -> f64 {
+        self.data.time()
+    }
+
+    fn timestep(&self) -> f64 {
+        self.shared.spec.physics.timestep_s
+    }
+
+    fn snapshot(&self) -> Option<crate::frames::Snapshot> {
+        let d = &self.data;
+        Some(crate::frames::Snapshot {
+            qpos: d.qpos().to_vec(),
+            qvel: d.qvel().to_vec(),
+            ctrl: d.ctrl().to_vec(),
+            act: d.act().to_vec(),
+        })
+    }
+
+    fn mujoco_data_mut(&mut self) -> Option<&mut MjData<Arc<MjModel>>> {
+        Some(&mut self.data)
+    }
+
+    fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
+        self.drive.set_growth(growth_m)
+    }
+
+    fn set_twine(&mut self, twine_m: f64) -> Result<(), PhysicsError> {
+        self.drive.set_twine(twine_m)
+    }
+
+    fn set_arm_target(&mut self, q: [f64; 6]) -> Result<(), PhysicsError> {
+        self.drive.set_arm_target(q, self.data.time())?;
+        Ok(())
+    }
+
+    fn step(&mut self) -> Result<(), PhysicsError> {
+        let t0 = self.data.time();
+        let dt = self.shared.spec.physics.timestep_s;
+        let before = self.drive.arm_q();
+        let set = self.drive.advance(t0, dt);
+        let ids = &self.shared.ids;
+        self.data.ctrl_mut()[ids.growth_act] = set.motors[0];
+        self.data.ctrl_mut()[ids.twine_act] = set.motors[1];
+        match ids.arm_act {
+            // Prescribed motion: the joint velocity that takes the actual angles to the next commanded
+            // ones in this step (so nothing drifts). Writing qpos directly instead doubled the step time.
+            None => {
+                for k in 0..6 {
+                    let actual = self.data.qpos()[ids.arm_qpos[k]];
+                    self.data.qvel_mut()[ids.arm_dof[k]] = (set.arm_q[k] - actual) / dt;
+                }
+            }
+            // The servos track the same interpolated setpoints, with the step's velocity fed forward
+            // as a UR's joint controller does. Holding each tick's target as the servos' setpoint
+            // instead made them chase a staircase (at the paper's 45 °/s, steps of 7.9 mrad every
+            // 10 ms) and lag (kv + damping) / kp = 0.1 s behind a moving setpoint.
+            Some(acts) => {
+                for k in 0..6 {
+                    let speed = (set.arm_q[k] - before[k]) / dt;
+                    self.data.ctrl_mut()[acts[k]] = set.arm_q[k] + ids.arm_servo_lead_s[k] * speed;
+                }
+                self.compensate_payload();
+            }
+        }
+        self.data.step();
+        self.check(t0 + dt)
+    }
+
+    fn set_object_force(&mut self, force_n: [f64; 3]) -> Result<(), PhysicsError> {
+        let Some(body) = self.shared.ids.object_body else {
+            return Err(PhysicsError::Config {
+                key: "disturbance.push".into(),
+                reason: "the scene has no object to push".into(),
+            });
+        };
+        if let Some(bad) = force_n.iter().find(|f| !f.is_finite()) {
+            return Err(PhysicsError::BadInput { what: "object push force", value: *bad });
+        }
+        // xfrc_applied: a Cartesian force and torque at the body's centre of mass, world frame.
+        self.data.xfrc_applied_mut()[body] = [force_n[0], force_n[1], force_n[2], 0.0, 0.0, 0.0];
+        Ok(())
+    }
+
+    fn readout(&self) -> PhysicsReadout {
+        let ids = &self.shared.ids;
+        let qpos = self.data.qpos();
+        let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
+        let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
+        let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
+        let tool_load_n = Some(self.vertical_force_on(&ids.hand_geoms, &ids.object_geoms));
+        let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
+        let hq = self.data.xquat()[ids.hand_body];
+        let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
+        let hand = Isometry3::from_parts(hand_p.into(), hand_rot);
+        let mut r = PhysicsReadout {
+            time_s: self.data.time(),
+            pad_force_n,
+            grip_force_n,
+            palm_force_n,
+            grip_contacts,
+            touching: grip_contacts > 0,
+            tool_load_n,
+            hand_pos_m: hand_p.into(),
+            growth_m: qpos[ids.growth_qpos],
+            twine_m: qpos[ids.twine_qpos],
+            twine_setpoint_m: self.drive.twine_setpoint_m(),
+            creep_m: qpos[ids.creep_qpos],
+            tendon_tension_n: self.tendon_tension_n(),
+            arm_q: match ids.arm_act {
+                Some(_) => ids.arm_qpos.map(|a| qpos[a]),
+                None => self.drive.arm_q(),
+            },
+            ..PhysicsReadout::default()
+        };
+        if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {
+            r.object_pos_m = self.data.xpos()[body];
+            r.object_quat = self.data.xquat()[body];
+            let p = Vector3::from(self.data.geom_xpos()[grip]);
+            let vo = self.data.object_velocity(_mjtObjBase::mjOBJ_GEOM, grip, false);
+            let vh = self.data.object_velocity(_mjtObjBase::mjOBJ_BODY, ids.hand_body, false);
+            let v_obj = Vector3::new(vo[3], vo[4], vo[5]);
+            let w_hand = Vector3::new(vh[0], vh[1], vh[2]);
+            let in_hand = grip_in_hand(&hand, Vector3::new(vh[3], vh[4], vh[5]), w_hand, p, v_obj);
+            r.object_vel_m_s = v_obj.into();
+            r.slip_speed_m_s = in_hand.slip_speed_m_s;
+            r.object_in_hand_m = in_hand.position_m;
+        }
+        r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_can_move_to_other_threads_and_share_the_model() {
+        fn send<T: Send>() {}
+        fn send_sync<T: Send + Sync>() {}
+        send::<Scene>();
+        send_sync::<SceneModel>();
+    }
+}

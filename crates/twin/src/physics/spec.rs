@@ -1,0 +1,43 @@
+//! [`SceneSpec`]: what a scene holds and how it is simulated.
+
+use super::config::{FingerConfig, ObjectConfig, PhysicsConfig};
+use tendril_config::{Checker, Validate};
+use tendril_ur5e::kinematics as ur5e;
+
+/// What a scene holds and how it is simulated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneSpec {
+    /// MuJoCo options, arm mode and divergence bounds.
+    pub physics: PhysicsConfig,
+    /// The finger's physical parameters.
+    pub finger: FingerConfig,
+    /// The object (and with it the table); `None` for a finger-only scene.
+    pub object: Option<ObjectConfig>,
+    /// Start joint angles of the arm \[rad\]. The object is placed where the grown finger wraps it in
+    /// this pose (see [`super::compose::placement`]).
+    pub arm_q0: [f64; 6],
+}
+
+impl Default for SceneSpec {
+    fn default() -> Self {
+        SceneSpec {
+            physics: PhysicsConfig::default(),
+            finger: FingerConfig::default(),
+            object: Some(ObjectConfig::default()),
+            arm_q0: ur5e::HOME,
+        }
+    }
+}
+
+impl Validate for SceneSpec {
+    fn validate(&self, at: &mut Checker) {
+        at.section("physics", &self.physics);
+        at.section("finger", &self.finger);
+        if let Some(o) = &self.object {
+            at.section("object", o);
+        }
+        for (i, q) in self.arm_q0.iter().enumerate() {
+            at.finite(&format!("arm_q0[{i}]"), *q);
+        }
+    }
+}
