@@ -72,7 +72,7 @@ fn physics(c: &mut Criterion) {
     let mut kinematic = SceneSpec::default();
     kinematic.physics.arm_mode = ArmMode::Kinematic;
     bench_scene(c, "full_scene_kinematic_arm_1s", kinematic);
-    // rapier at 32 uniform links and a 5 ms step, the setting of README's rapier comparison: at 64
+    // rapier at 32 uniform links and a 5 ms step, the setting of the rapier comparison (docs/studies/rapier.md): at 64
     // uniform links and 1.25 ms it runs at about 0.1x real time.
     let mut rapier = SceneSpec {
         physics: PhysicsConfig { timestep_s: 0.005, ..PhysicsConfig::on(Backend::Rapier) },

@@ -12,7 +12,7 @@ use tendril_run::scenario::PickPlaceScenario;
 use tendril_twin::physics::Backend;
 
 /// The shipped scenario on `backend`: MuJoCo at the converged default; rapier at 32 uniform links
-/// and a 5 ms step, the setting of README's rapier comparison (at 64 uniform links and 1.25 ms it
+/// and a 5 ms step, the setting of the rapier comparison (docs/studies/rapier.md) (at 64 uniform links and 1.25 ms it
 /// runs at about 0.1x real time, and `cargo test --all-targets` runs every bench once).
 fn scenario(name: &str, backend: Backend) -> PickPlaceScenario {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios").join(format!("{name}.toml"));

@@ -12,6 +12,7 @@
 //! - [`study`]: studies over many runs, charted (`tendril chart`).
 //! - [`fit`]: calibrating the twin to recorded runs (`tendril fit`) and tuning the controller on it
 //!   (`tendril tune`).
+//! - [`keys`]: the scenario key reference (`tendril keys`), generated from the code.
 //! - [`reproduce`]: the paper's figures next to the twin's (`tendril reproduce`).
 //! - [`signals`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
 
@@ -19,6 +20,7 @@
 
 pub mod cli;
 pub mod fit;
+pub mod keys;
 pub mod render;
 pub mod reproduce;
 pub mod signals;

@@ -82,11 +82,11 @@ fn bad_backend_settings_name_the_file_and_key() {
 
 /// rapier runs at about 0.1x real time on the converged uniform finger (64 links, 1.25 ms: the short
 /// lift's 12 s took 105 CPU-s), too slow for CI; its tests run at 32 uniform links and a 5 ms step,
-/// the setting of README's rapier comparison.
+/// the setting of the rapier comparison (docs/studies/rapier.md#the-papers-rows-on-rapier).
 const RAPIER_NUMERICS: [&str; 6] =
     ["--set", "finger.segments=32", "--set", "finger.base_refinement=1", "--set", "physics.timestep_s=0.005"];
 
-/// The rows rapier reproduces with MuJoCo's calibration at [`RAPIER_NUMERICS`] (README, "The rapier
+/// The rows rapier reproduces with MuJoCo's calibration at [`RAPIER_NUMERICS`] (docs/studies/rapier.md#the-papers-rows-on-rapier
 /// backend"): every feedback row of the crimper and the hammer, the shampoo's outcome and rise with
 /// feedback, and its drop without (14.4 s in the transfer). Reported, not asserted: rapier drops the
 /// crimper in the transfer (13.5 s) and the hammer in the lift (8.1 s), and the shampoo's

@@ -61,7 +61,7 @@ fn a_knock_in_the_transfer_is_survived_by_its_size_whatever_the_controller() {
     // On the 8-link finger the feedforward (which does not loosen while the arm moves) kept the
     // crimper through a 0.3 N·s knock that the PID lost; on the converged finger the knock decides
     // alone: 0.2 N·s is carried by both, 0.3 N·s knocks it out within half a second under either,
-    // before any controller acts (README, "Disturbances").
+    // before any controller acts (docs/studies/controllers.md#why-the-goal-is-out-of-reach-under-the-knock).
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml");
     let knocked = |controller: &str, impulse: f64| {
         let overrides: Vec<tendril_config::Override> = [

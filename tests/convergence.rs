@@ -72,7 +72,7 @@ fn the_quick_study_judges_its_own_rows_by_the_criteria() {
 }
 
 /// The same criterion on all three objects (seed 1): 18 runs, about 4 CPU-minutes, so CI runs the
-/// crimper's (above) and this one runs with `cargo test -- --ignored`; the README's full study
+/// crimper's (above) and this one runs with `cargo test -- --ignored`; the full study (docs/studies/convergence.md#where-it-stands)
 /// (seed 1, down to step/4 and links ×4) covers every case.
 #[test]
 #[ignore = "about 4 CPU-minutes; the crimper's quick study above is the CI criterion"]

@@ -13,7 +13,7 @@ const G: f64 = 9.81;
 
 /// `mod mujoco` and `mod rapier`, each with one `#[test]` per named check.
 /// Checks after `; rapier_open:` run on MuJoCo and are ignored on rapier, where they fail on the
-/// 32-link finger (`cargo test -- --ignored` runs them; README, "The rapier backend").
+/// 32-link finger (`cargo test -- --ignored` runs them; docs/studies/rapier.md#the-papers-rows-on-rapier).
 macro_rules! both_backends {
     ($($check:ident),* $(,)? ; rapier_open: $($open:ident),* $(,)?) => {
         mod mujoco {
@@ -24,7 +24,7 @@ macro_rules! both_backends {
             $(#[test] fn $check() { super::$check(tendril_twin::physics::Backend::Rapier) })*
             $(
                 #[test]
-                #[ignore = "fails on rapier with the 32-link finger (README, The rapier backend)"]
+                #[ignore = "fails on rapier with the 32-link finger (docs/studies/rapier.md#the-papers-rows-on-rapier)"]
                 fn $open() { super::$open(tendril_twin::physics::Backend::Rapier) }
             )*
         }
@@ -48,7 +48,7 @@ both_backends!(
 );
 
 /// MuJoCo at its defaults. rapier at 5 ms: at a 1.25 ms step with 64 uniform links it runs at
-/// about 0.1x real time, too slow for these checks in CI (README, "The rapier backend"); and with
+/// about 0.1x real time, too slow for these checks in CI (docs/studies/rapier.md#speed); and with
 /// its prescribed arm, the only one it has.
 fn physics(backend: Backend) -> PhysicsConfig {
     let timestep_s = match backend {
@@ -121,7 +121,7 @@ fn pinch_holds(p: &PhysicsConfig, force: f64, mu: f64, a: f64) -> bool {
 
 /// Tolerance on the smallest holding force. MuJoCo: 5 % (measured +0.02 % with the default's stiff
 /// 5 ms contacts and no noslip pass). rapier:
-/// 5 % too (modeling.md measured about 4 % off at 5 ms; its contacts are solved by impulses per step).
+/// 5 % too (docs/facts.md#rapier-pinch-holding-force measured about 4 % off at 5 ms; its contacts are solved by impulses per step).
 fn pinch_holding_force_matches_analytic_bound(backend: Backend) {
     let p = physics(backend);
     let (mass, mu, a) = (0.35, 0.8, 2.0);

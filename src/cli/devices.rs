@@ -26,7 +26,7 @@ pub struct DeviceArgs {
     #[arg(long, value_parser = port_base)]
     port_base: Option<u16>,
     /// Sensor watchdog: stop when the latest peak sample is this old [ms] [default: 10 control
-    /// ticks plus one interrogator period, 101 ms at 100 Hz and 1 kHz; docs/hardware.md, "Watchdogs"].
+    /// ticks plus one interrogator period, 101 ms at 100 Hz and 1 kHz; docs/cell/timing.md#watchdogs].
     #[arg(long)]
     sensor_stale_ms: Option<f64>,
     /// Arm watchdog: stop when the latest RTDE sample is this old [ms] [default: 10 control ticks

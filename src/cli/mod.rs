@@ -3,6 +3,7 @@
 mod chart;
 mod devices;
 mod fit;
+mod keys;
 mod latency;
 mod physics;
 mod plot;
@@ -76,6 +77,9 @@ enum Command {
     Serve(serve::ServeArgs),
     /// Measure the real path's control-tick latency against the virtual devices on loopback.
     Latency(latency::LatencyArgs),
+    /// Print the scenario key reference (Markdown): every key with its unit, default, bounds and
+    /// meaning, from the code (the book's "Scenario keys" page).
+    Keys(keys::KeysArgs),
 }
 
 /// Runs the CLI and maps errors to a non-zero exit code with a one-line message.
@@ -100,6 +104,7 @@ pub fn main() -> ExitCode {
         Command::Scene(a) => physics::scene(a),
         Command::Serve(a) => serve::run(a),
         Command::Latency(a) => latency::run(a),
+        Command::Keys(a) => keys::run(a),
     };
     let code = match result {
         Ok(code) => code,

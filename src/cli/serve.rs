@@ -34,8 +34,8 @@ pub struct ServeArgs {
     #[arg(long = "set")]
     set: Vec<Override>,
     /// Timing faults the devices inject into their links, to try a client against an ordinary PC
-    /// or a Wi-Fi link: `loopback`, `busy-pc` or `wifi` (each stated in docs/hardware.md, "Timing
-    /// on an ordinary PC") [default: none].
+    /// or a Wi-Fi link: `loopback`, `busy-pc` or `wifi` (each stated in
+    /// docs/cell/timing.md#injected-jitter) [default: none].
     #[arg(long, value_enum, default_value = "none")]
     jitter: JitterProfile,
     /// Seed of the injected jitter's delays.
@@ -73,10 +73,7 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     ));
     if let Some(j) = config.jitter {
         let link = j.only.map_or("every link".to_string(), |l| format!("{l:?}"));
-        emit(&format!(
-            "  jitter    {:?} on {link}, seed {} (docs/hardware.md, \"Injected jitter\")\n",
-            a.jitter, j.seed
-        ));
+        emit(&format!("  jitter    {:?} on {link}, seed {} (docs/cell/timing.md#injected-jitter)\n", a.jitter, j.seed));
     }
     // Ctrl-C, SIGTERM and SIGHUP alike: the devices are shut down and the status reported.
     crate::signals::install_signal_handlers()?;

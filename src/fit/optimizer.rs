@@ -10,7 +10,7 @@
 //! and charged its squared distance, so the search is pulled back without a wall.
 //!
 //! CMA-ES is a local search: from a start on a plateau, or beside a narrow valley, it settles
-//! where it began (the paper fit: README, "Fit to the paper"). `budget.prescreen` first evaluates
+//! where it began (the paper fit: docs/studies/fit-paper.md#why-a-prescreen-was-needed). `budget.prescreen` first evaluates
 //! that many quasi-random points spread evenly over the whole cube ([`spread_points`]) and starts
 //! the search from the best of them and the start.
 

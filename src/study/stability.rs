@@ -13,7 +13,7 @@ pub const INTEGRATORS: [&str; 4] = ["euler", "implicitfast", "implicit", "rk4"];
 /// The rapier series' label (rapier steps with its PGS solver and symplectic Euler).
 pub const RAPIER_SERIES: &str = "pgs";
 /// The rapier series' finger: 32 uniform links (`finger.base_refinement` 1), as in its tests, where
-/// its calibration was checked (README, "The rapier backend"). At 64 uniform links rapier runs at
+/// its calibration was checked (docs/studies/rapier.md#the-papers-rows-on-rapier). At 64 uniform links rapier runs at
 /// about 0.1x real time, and the 1 ms point alone would take ten minutes.
 pub const RAPIER_SEGMENTS: u32 = 32;
 

@@ -9,6 +9,8 @@
 //!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv.
 //! - `cargo xtask layers`: check the workspace's rules (the crates' layers, the light crates'
 //!   dependencies, no module loops; [`layers`]).
+//! - `cargo xtask book`: build the book in `docs/` into `target/book` with mdBook, installed
+//!   first (the pinned version, from crates.io) into `vendor/mdbook`.
 //! - `cargo xtask publish-check`: `cargo publish --dry-run` of the crates made to be used on their
 //!   own ([`layers::PUBLISHED`]): each is packaged and built from its package alone.
 
@@ -31,13 +33,14 @@ fn main() -> ExitCode {
         "main" => fetch_mujoco().and_then(|_| run_main(rest)),
         "test" => fetch_mujoco().and_then(|_| run_tests(rest)),
         "layers" => check_layers(),
+        "book" => build_book(rest),
         "publish-check" => run(cargo()
             .args(["publish", "--dry-run"])
             .args(layers::PUBLISHED.iter().flat_map(|p| ["--package", p]))
             .args(rest)
             .current_dir(workspace_root())),
         _ => {
-            eprintln!("usage: cargo xtask <fetch|main|test|layers|publish-check> [extra cargo args]");
+            eprintln!("usage: cargo xtask <fetch|main|test|layers|book|publish-check> [extra cargo args]");
             return ExitCode::from(2);
         }
     };
@@ -117,6 +120,26 @@ fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     c.current_dir(workspace_root());
     c
+}
+
+/// mdBook's version: the book's `book.toml` and pages are written for it.
+const MDBOOK_VERSION: &str = "0.5.4";
+
+/// Builds `docs/` with mdBook, installing it into `vendor/mdbook` first when it is not there
+/// (without its `serve` and `watch` features: a build needs neither, and they would pull in tokio
+/// and a file watcher). The book's links are checked by `tests/docs_links.rs`.
+fn build_book(extra: &[String]) -> Result<(), String> {
+    let root = workspace_root();
+    let prefix = root.join("vendor/mdbook");
+    let mdbook = prefix.join("bin/mdbook");
+    let installed = Command::new(&mdbook).arg("--version").output().ok().map(|o| o.stdout);
+    if installed.as_deref() != Some(format!("mdbook v{MDBOOK_VERSION}\n").as_bytes()) {
+        run(cargo()
+            .args(["install", "mdbook", "--locked", "--no-default-features", "--features", "search"])
+            .args(["--version", MDBOOK_VERSION, "--root"])
+            .arg(&prefix))?;
+    }
+    run(Command::new(&mdbook).args(["build", "docs"]).args(extra).current_dir(&root))
 }
 
 /// The main job: reproduce the paper's results with the twin.

@@ -1,6 +1,6 @@
 //! The grow-and-twine gripper's drive train: motor angles to finger inputs.
 //!
-//! Two MX-106 servos drive the finger (modeling.md): one feeds the strip out of its guide
+//! Two MX-106 servos drive the finger (docs/facts.md#gripper-drive-two-mx-106-servos): one feeds the strip out of its guide
 //! through a spur pinion (growth), one winds the curl tendon on a spool (twine). The control
 //! code thinks in finger terms (growth length, tendon pull); the cell speaks motor angles.
 
@@ -11,7 +11,7 @@ use tendril_config::{Checker, Validate};
 pub const MX106_MAX_SPEED_DEG_S: f64 = 270.0;
 
 /// Drive-train geometry (TOML `[gripper]`). The real gripper's dimensions are unpublished
-/// (modeling.md); these are documented choices.
+/// (docs/facts.md#gripper-dimensions-are-unpublished); these are documented choices.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GripperConfig {

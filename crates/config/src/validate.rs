@@ -23,6 +23,8 @@ pub trait Validate {
 pub struct Checker {
     prefix: Vec<String>,
     errors: Vec<(String, String)>,
+    /// Every bound checked, as (dotted key, the rule): what the scenario key reference shows.
+    rules: Vec<(String, String)>,
 }
 
 impl Checker {
@@ -47,23 +49,32 @@ impl Checker {
         }
     }
 
+    fn rule(&mut self, name: &str, rule: String) {
+        let key = self.key(name);
+        self.rules.push((key, rule));
+    }
+
     /// `value` must be finite and strictly positive.
     pub fn positive(&mut self, name: &str, value: f64) {
+        self.rule(name, "> 0".into());
         self.require(name, value.is_finite() && value > 0.0, || format!("must be > 0, got {value}"));
     }
 
     /// `value` must be finite and not negative.
     pub fn non_negative(&mut self, name: &str, value: f64) {
+        self.rule(name, ">= 0".into());
         self.require(name, value.is_finite() && value >= 0.0, || format!("must be >= 0, got {value}"));
     }
 
     /// `value` must be finite.
     pub fn finite(&mut self, name: &str, value: f64) {
+        self.rule(name, "finite".into());
         self.require(name, value.is_finite(), || format!("must be a finite number, got {value}"));
     }
 
     /// `value` must lie in `[lo, hi]`.
     pub fn in_range(&mut self, name: &str, value: f64, lo: f64, hi: f64) {
+        self.rule(name, format!("{} to {}", compact(lo), compact(hi)));
         self.require(name, value.is_finite() && (lo..=hi).contains(&value), || {
             format!("must be between {lo} and {hi}, got {value}")
         });
@@ -74,8 +85,20 @@ impl Checker {
         self.errors.into_iter().next()
     }
 
+    /// Every bound checked so far, as (dotted key, rule: `> 0`, `>= 0`, `finite`, `LO to HI`),
+    /// whether the value met it or not. Checks that [`Checker::require`] makes with a reason of
+    /// their own are not listed.
+    pub fn rules(&self) -> &[(String, String)] {
+        &self.rules
+    }
+
     /// Every error recorded, as (dotted key, reason).
     pub fn errors(&self) -> &[(String, String)] {
         &self.errors
     }
+}
+
+/// A bound as a reader wants it: `0.001`, `10000`, `1e-300` (not 300 zeros).
+fn compact(x: f64) -> String {
+    if x != 0.0 && !(1e-4..1e7).contains(&x.abs()) { format!("{x:e}") } else { format!("{x}") }
 }

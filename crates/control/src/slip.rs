@@ -25,7 +25,7 @@
 //! hangs on the palm's pinch for seconds after the pad lost it), and an object sliding through a
 //! grip whose pad keeps its load (near-zero friction). What neither sees: an object that slides
 //! down the grip and stays in the hand (the knocked hammer), whose weight the hand still carries.
-//! README, "Disturbances", has the figures.
+//! docs/studies/disturbances.md#measured has the figures.
 
 use super::contact::{MAX_WINDOW_TICKS, Z};
 use super::load::{LoadCue, LoadCues};

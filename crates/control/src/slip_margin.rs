@@ -62,7 +62,7 @@ pub struct SlipMarginConfig {
     /// the grip at rest too.
     pub margin: f64,
     /// Distance from the arm's joint axes to the object \[m\]. Default 0.6 m: the hand at home sits
-    /// about 0.6 m out from the UR5e's base and shoulder axes (its reach is 0.85 m, hardware.md).
+    /// about 0.6 m out from the UR5e's base and shoulder axes (its reach is 0.85 m, docs/facts.md#ur5e-reach).
     pub lever_m: f64,
     /// How long before the move the target starts to rise \[s\]. Default 2 s: one closed-loop
     /// time constant of the paper's PID on the twin (≈ 2 s).
@@ -113,7 +113,7 @@ impl Validate for SlipMarginConfig {
         // A setpoint more than twice the limit, or a margin of 100 %, is no longer a margin.
         at.in_range("static_margin", self.static_margin, 0.0, 1.0);
         at.in_range("margin", self.margin, 0.0, 1.0);
-        // The UR5e reaches 0.85 m (hardware.md); 2 m allows a tool extension.
+        // The UR5e reaches 0.85 m (docs/facts.md#ur5e-reach); 2 m allows a tool extension.
         at.in_range("lever_m", self.lever_m, 0.0, 2.0);
         at.in_range("lead_s", self.lead_s, 0.0, 60.0);
         // 1 N/° would take the finger through its 4.69 N range in under 5°.

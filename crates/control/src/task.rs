@@ -17,7 +17,7 @@ use tendril_config::{Checker, Validate};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TaskConfig {
-    /// Home pose above the object [°]: the UR5e's common home (hardware.md).
+    /// Home pose above the object [°]: the UR5e's common home (docs/facts.md#ur5e-home-pose).
     pub home_deg: [f64; ARM_JOINTS],
     /// Pose at the top of the lift [°]: shoulder and elbow raise the tool about 15 cm.
     pub lift_deg: [f64; ARM_JOINTS],
@@ -102,7 +102,7 @@ impl Validate for TaskConfig {
             ("transfer_deg", &self.transfer_deg),
             ("place_deg", &self.place_deg),
         ] {
-            // UR5e joint limits ±360° (hardware.md).
+            // UR5e joint limits ±360° (docs/facts.md#ur5e-joint-limits).
             at.require(name, pose.iter().all(|q| q.is_finite() && q.abs() <= 360.0), || {
                 format!("every joint angle must lie within ±360°, got {pose:?}")
             });

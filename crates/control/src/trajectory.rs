@@ -26,7 +26,7 @@ impl Default for JointLimits {
 
 impl Validate for JointLimits {
     fn validate(&self, at: &mut Checker) {
-        // The UR5e's joints reach 180 °/s (hardware.md); faster targets would not be followed.
+        // The UR5e's joints reach 180 °/s (docs/facts.md#ur5e-joint-speed); faster targets would not be followed.
         at.in_range("max_speed_deg_s", self.max_speed_deg_s, 1e-3, 180.0);
         // 1e4 °/s²: reaches the UR5e's top joint speed in 18 ms, beyond what its drives deliver
         // with a payload; below 1e-3 °/s² a move would take days.

@@ -59,8 +59,8 @@ pub const DEFAULT_CONTROL_PERIOD_S: f64 = 0.01;
 /// (not real-time) Linux PC does not run a process for several milliseconds every few seconds
 /// (7-16 ms seen on loopback, tens of ms on a shared virtual machine), so limits of a few device
 /// periods (once 5 ms for the 1 kHz peak stream, 10 ms for RTDE) stopped most runs on a healthy
-/// cell; a stream that really stops is still caught within the limit plus one tick. docs/hardware.md,
-/// "Watchdogs", gives each limit and the measurements behind them.
+/// cell; a stream that really stops is still caught within the limit plus one tick. docs/cell/timing.md#watchdogs
+/// gives each limit and the measurements behind them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Watchdog {
     /// Peak samples (HYPERION stream) older than this stop the cell \[s\].
@@ -119,7 +119,7 @@ pub struct RealCellConfig {
     pub stream_port: u16,
     /// Motor IDs, bus speed, FBG windows (the scenario's `[hardware]`).
     pub hardware: HardwareConfig,
-    /// Interrogator sample period \[s\] (1 kHz on the si255, hardware.md).
+    /// Interrogator sample period \[s\] (1 kHz on the si255, docs/facts.md#hyperion-scan-rate).
     pub sensor_period_s: f64,
     /// How old each stream's latest sample may be before the cell stops.
     pub watchdog: Watchdog,

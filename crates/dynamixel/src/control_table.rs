@@ -51,7 +51,7 @@ pub const RAM_START: u16 = 64;
 /// Size of the modelled table (addresses 0..=146).
 pub const TABLE_LEN: usize = 147;
 
-/// Addresses the drivers use (hardware.md).
+/// Addresses the drivers use (docs/facts.md#mx-106-control-table).
 pub mod addr {
     /// Model Number (2 bytes, 321).
     pub const MODEL_NUMBER: u16 = 0;

@@ -1,4 +1,4 @@
-//! MX-106 unit conversions (hardware.md: 4096 ticks/rev (0.088°/tick), 0.229 rpm, 3.36 mA).
+//! MX-106 unit conversions (docs/facts.md#mx-106-units: 4096 ticks/rev (0.088°/tick), 0.229 rpm, 3.36 mA).
 //!
 //! Position ticks map linearly to radians with 0 ticks = 0 rad; where the mechanism's zero is
 //! (e.g. 2048 = mid-range in position mode) is the driver's calibration, not the codec's.

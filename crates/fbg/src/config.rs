@@ -133,7 +133,7 @@ pub enum InterrogatorMode {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InterrogatorConfig {
-    /// Sample rate \[Hz\]; the si255 runs at 1 kHz (hardware.md).
+    /// Sample rate \[Hz\]; the si255 runs at 1 kHz (docs/facts.md#hyperion-scan-rate).
     pub sample_rate_hz: f64,
     /// Standard deviation of the peak-wavelength noise in analytic mode \[pm\]; paper: "≈ 3 pm".
     pub noise_pm: f64,
@@ -159,7 +159,7 @@ impl Default for InterrogatorConfig {
 
 impl Validate for InterrogatorConfig {
     fn validate(&self, at: &mut Checker) {
-        // 1 Hz to 10 kHz: the HYPERION si255 runs at 1 kHz (hardware.md), the fastest HYPERION
+        // 1 Hz to 10 kHz: the HYPERION si255 runs at 1 kHz (docs/facts.md#hyperion-scan-rate), the fastest HYPERION
         // models at 5 kHz; the twin draws every sample, so 1e9 Hz makes no progress, and below
         // 1 Hz no control loop is fed.
         at.in_range("sample_rate_hz", self.sample_rate_hz, 1.0, 10_000.0);
@@ -172,7 +172,7 @@ impl Validate for InterrogatorConfig {
 /// The sampled spectrum and the peak detector of spectral mode.
 ///
 /// Each grating reflects a Gaussian line (the common stand-in for an apodized grating: apodization
-/// suppresses the side lobes, modeling.md). The interrogator samples the summed spectrum on a
+/// suppresses the side lobes, docs/facts.md#peak-detection). The interrogator samples the summed spectrum on a
 /// fixed grid with additive intensity noise; each channel's peak is the centroid of the samples
 /// above `threshold` × the channel maximum (Tosi 2017's centroid detector).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -27,7 +27,7 @@ pub struct InterrogatorConfig {
     pub channel_count: u32,
     /// Most peaks reported per channel.
     pub max_peaks_per_channel: u32,
-    /// Laser scan speeds offered, Hz (hardware.md guesses about 1 kHz).
+    /// Laser scan speeds offered, Hz (docs/facts.md#hyperion-scan-rate guesses about 1 kHz).
     pub available_scan_speeds_hz: Vec<i32>,
     /// FPGA version string (ours).
     pub fpga_version: String,

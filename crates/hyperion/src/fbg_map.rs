@@ -48,7 +48,7 @@ impl Validate for FbgWindows {
             ("fbg2_min_nm", self.fbg2_min_nm),
             ("fbg2_max_nm", self.fbg2_max_nm),
         ] {
-            // The si255 sweeps 1460-1620 nm (hardware.md, unverified).
+            // The si255 sweeps 1460-1620 nm (docs/facts.md#hyperion-wavelength-range, unverified).
             at.in_range(name, value, 1460.0, 1620.0);
         }
         at.require("fbg1_max_nm", self.fbg1_max_nm > self.fbg1_min_nm, || "must exceed fbg1_min_nm".to_string());

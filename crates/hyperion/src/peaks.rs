@@ -1,6 +1,6 @@
 //! Peak data: the content of `#GetPeaks` and of each frame streamed on TCP 51972.
 //!
-//! Layout (hardware.md, from Luna's `hyperion.py`): a 24-byte header `u16 length,
+//! Layout (docs/facts.md#hyperion-peak-data-layout, from Luna's `hyperion.py`): a 24-byte header `u16 length,
 //! u8 buffer_available, u8 version, u32 reserved, u64 serial_number, u32 timestamp_s,
 //! u32 timestamp_ns`, then one i16 peak count per channel up to `length` bytes, then the f64
 //! peak wavelengths (nm) of all channels in channel order. Little-endian.

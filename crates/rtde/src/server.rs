@@ -1,6 +1,6 @@
 //! The controller side of RTDE: a sans-IO session the virtual UR5e runs per TCP connection.
 //!
-//! Compatibility notes (SDU `ur_rtde`, hardware.md): every request gets exactly one reply and
+//! Compatibility notes (SDU `ur_rtde`, docs/facts.md#ur_rtde-client-behaviour): every request gets exactly one reply and
 //! the session never sends an unsolicited text message during setup (ur_rtde reads one packet
 //! per request); name lists may end with a comma; unknown names get `NOT_FOUND` in the reply
 //! (the recipe is then invalid, ID 0), never a dropped connection.

@@ -63,7 +63,7 @@ pub struct Tolerances {
 }
 
 /// The tolerances of the real-path tests and the jitter study, from repeated runs against the
-/// virtual devices (docs/hardware.md, "Timing on an ordinary PC"):
+/// virtual devices (docs/cell/timing.md):
 /// - while the finger grows and wraps, 0.1 N (a sixth of the 0.6 N setpoint, about 40 times the
 ///   sensor's 2.6 mN resolution);
 /// - in the grasp, 0.25 N: the force rises from contact to the setpoint there, and where the coil

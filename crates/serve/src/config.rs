@@ -34,7 +34,7 @@ pub struct ServeConfig {
     /// waiting behind other processes, and a CPU of their own keeps them off the control thread's.
     pub realtime: RealtimeOptions,
     /// An RTDE or HYPERION command connection on which nothing is received or sent for this long is
-    /// closed (default [`IDLE_TIMEOUT`]); see `docs/hardware.md`.
+    /// closed (default [`IDLE_TIMEOUT`]); see `docs/cell/virtual-devices.md`.
     pub idle_timeout: Duration,
     /// Timing faults injected into the RTDE streams (both ways), the peak stream and the Dynamixel
     /// bus ([`crate::jitter`]; default none).

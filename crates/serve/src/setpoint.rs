@@ -11,7 +11,7 @@
 //! 100 Hz during the short lift, which rattled the pad against the object: the pad force changed
 //! by 0.07-0.10 N from step to step and lost contact for single steps (against 1 mN per step on the
 //! simulated path), and the real path's estimate in the lift read 0.16-1.1 N where the twin's read
-//! 0.54-0.58 N (measured; docs/hardware.md, "Timing on an ordinary PC").
+//! 0.54-0.58 N (measured; docs/cell/timing.md#what-made-the-lift-shake-and-where-it-was-fixed).
 
 use std::collections::VecDeque;
 use tendril_urscript::interp::CONTROL_PERIOD_S;

@@ -1,4 +1,4 @@
-//! UR5e kinematics from UR's DH table (hardware.md): forward kinematics to the tool flange and a
+//! UR5e kinematics from UR's DH table (docs/facts.md#ur5e-dh-table): forward kinematics to the tool flange and a
 //! damped-least-squares inverse near a seed, for the kinematic arm mode, for planning poses and for
 //! the slip detector's hand height (`tendril_control::slip`).
 
@@ -11,7 +11,7 @@ pub const A: [f64; 6] = [0.0, -0.425, -0.3922, 0.0, 0.0, 0.0];
 /// DH alpha \[rad\].
 pub const ALPHA: [f64; 6] =
     [std::f64::consts::FRAC_PI_2, 0.0, 0.0, std::f64::consts::FRAC_PI_2, -std::f64::consts::FRAC_PI_2, 0.0];
-/// A commonly used home pose \[rad\] (hardware.md): tool flange pointing down.
+/// A commonly used home pose \[rad\] (docs/facts.md#ur5e-home-pose): tool flange pointing down.
 pub const HOME: [f64; 6] = [
     -std::f64::consts::FRAC_PI_2,
     -std::f64::consts::FRAC_PI_2,

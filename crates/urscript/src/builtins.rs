@@ -1,6 +1,6 @@
 //! The built-in functions the virtual controller implements (URScript manual names, parameters
 //! and defaults). Anything else is a runtime error naming the function, as a controller rejects a
-//! program calling an unknown function. The list is in `docs/hardware.md`.
+//! program calling an unknown function. The list is in `docs/cell/urscript.md`.
 
 use super::controller::{Controller, DigitalOut};
 use super::motion::Arm;

@@ -15,7 +15,7 @@
 //!   cadence, the smoothing `servoj`'s lookahead gives on the real controller. Re-commanding an
 //!   unchanged target every 2 ms instead would make the arm jump to each new target within one
 //!   physics step and stand still until the next (the hand shook at the control rate, see
-//!   `docs/hardware.md`).
+//!   `docs/cell/urscript.md`).
 //! - `speedj(qd, a, t)`: joint speeds ramped towards `qd` at `a`; when the call that set them has
 //!   returned and no new `speedj` follows within a cycle, the arm decelerates at `a`.
 //! - `stopj(a)`: every joint decelerates at `a`, scaled so they stop together. After `servoj` the

@@ -14,7 +14,7 @@ pub const TARE_WINDOW_S: f64 = 0.5;
 /// Force bins for the hysteresis study \[N\].
 pub const HYSTERESIS_BIN_N: f64 = 0.1;
 /// Play widths \[N\] of the hysteresis model fitted for software compensation: spread over the
-/// range so the fitted weights can shape any lens-like loop (modeling.md: 3-5 plays).
+/// range so the fitted weights can shape any lens-like loop (docs/facts.md#prandtl-ishlinskii-hysteresis: 3-5 plays).
 pub const COMPENSATION_PLAY_WIDTHS_N: [f64; 5] = [0.25, 0.5, 1.0, 1.5, 2.0];
 
 /// Result of the force calibration on a load/unload record.

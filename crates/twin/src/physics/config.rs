@@ -23,7 +23,7 @@ pub enum Integrator {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Cone {
-    /// Pyramidal approximation: creeps below the friction limit (see modeling.md).
+    /// Pyramidal approximation: creeps below the friction limit (see docs/facts.md#mujoco-pyramidal-cones-creep).
     Pyramidal,
     /// Exact Coulomb cone.
     Elliptic,
@@ -107,20 +107,20 @@ pub enum RapierFriction {
 /// `timestep_s`, `arm_mode`, `arm_max_speed_rad_s` and the divergence bounds do).
 ///
 /// Defaults chosen with tests/physics_validation.rs, which runs the analytic cases on both backends,
-/// and the facts measured for rapier 0.36 in ../shared/reference/modeling.md.
+/// and the facts measured for rapier 0.36 in docs/facts.md#rapier-036.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RapierConfig {
     /// Solver iterations per step. 8: 4 run 1.8x faster, but in the speed/accuracy study (crimper,
     /// 5 ms, 8 links, against the MuJoCo reference) the drop lands 1.5 s off with 4 and 0.2 s with 8
-    /// (force RMSE 0.14 vs 0.12 N). modeling.md saw a 12-link multibody chain track its spring
+    /// (force RMSE 0.14 vs 0.12 N). The facts (docs/facts.md#rapier-multibody-chain) saw a 12-link multibody chain track its spring
     /// targets to 0.03 rad at 4; the contacts with a 0.4 kg object are what want more.
     pub solver_iterations: u32,
     /// Internal PGS iterations per solver iteration.
     pub pgs_iterations: u32,
     /// Stabilisation (position-correction) iterations per solver iteration.
     pub stabilization_iterations: u32,
-    /// Friction model between rigid bodies. `simplified`: modeling.md measured the slip angle within
+    /// Friction model between rigid bodies. `simplified`: docs/facts.md#rapier-friction-model measured the slip angle within
     /// 0.03 deg of atan(mu) with it, where the Coulomb model slips about 1.5 deg early.
     pub friction_model: RapierFriction,
     /// Natural frequency of the contact constraints' softness \[Hz\]. rapier's default, 30.
@@ -186,7 +186,7 @@ pub enum ArmMode {
     /// the dynamic arm), the frozen grip relaxes faster and the shampoo without feedback drops
     /// 0.85 s early. The chatter grows with the armature (the shampoo's drop 13.9 / 13.0 / 11.9 s at
     /// 100 / 1000 / 10 000 kg m^2) and is gone at 0.3125 ms, where the drop is the dynamic arm's
-    /// (README, "Convergence"). The only mode of the rapier backend.
+    /// (docs/studies/convergence.md#why-the-shampoos-drop-used-to-move-with-the-step-the-prescribed-arm). The only mode of the rapier backend.
     Kinematic,
     /// The six joints with masses, gravity compensation and position servos (models/ur5e.xml). The
     /// servos track the same setpoints the prescribed arm moves along (each tick's target spread
@@ -210,12 +210,11 @@ impl ArmMode {
 
 /// `[physics]`: MuJoCo options and the divergence bounds.
 ///
-/// Defaults are the converged setting (README, "Convergence"): elliptic cones and a Newton solver with
-/// a small tolerance (MuJoCo's advice for slip accuracy; modeling.md measured that pyramidal cones
+/// Defaults are the converged setting (docs/studies/convergence.md#where-it-stands): elliptic cones and a Newton solver with
+/// a small tolerance (MuJoCo's advice for slip accuracy; docs/facts.md#mujoco-pyramidal-cones-creep measured that pyramidal cones
 /// creep), stiff contacts that hold objects without noslip iterations, and the largest step at which
 /// the Section V answers agree with half that step and the contacts keep their time constant. About
-/// 30x real time on one core with the default graded finger (benches/scenario.rs; README, "Speed
-/// and accuracy").
+/// 30x real time on one core with the default graded finger (benches/scenario.rs; docs/studies/speed-accuracy.md#the-figures).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
@@ -239,7 +238,7 @@ pub struct PhysicsConfig {
     /// Integrator. `implicitfast`: the creep dashpot (thousands of N s/m on a 1 g node) and the servos'
     /// `kv` are integrated implicitly, which explicit Euler would not survive at this step.
     pub integrator: Integrator,
-    /// Friction cone. `elliptic`: exact Coulomb limit (pyramidal creeps, modeling.md).
+    /// Friction cone. `elliptic`: exact Coulomb limit (pyramidal creeps, docs/facts.md#mujoco-pyramidal-cones-creep).
     pub cone: Cone,
     /// Ratio of frictional to normal constraint impedance. 3: the pinch test's smallest holding
     /// force is the analytic one (tests/physics_validation.rs; measured with 20 ms contacts at 5 ms,
@@ -255,7 +254,7 @@ pub struct PhysicsConfig {
     /// Solver tolerance (relative cost improvement). 1e-8: friction converged; tighter costs time for
     /// no measurable change in the validation results, and in the six Section V runs 1e-9 and 1e-10
     /// move no drop by more than 0.3 s and no fluctuation by more than 1 point, where 1e-6 moves the
-    /// shampoo's drop by 2 s (README, "Convergence").
+    /// shampoo's drop by 2 s (docs/studies/convergence.md#the-solvers-settings).
     pub tolerance: f64,
     /// Line-search iterations of the Newton solver. 20: with 5 the object sank 14 mm into the table
     /// during a grasp (measured).
@@ -263,8 +262,8 @@ pub struct PhysicsConfig {
     /// Post-solve no-slip iterations. 0: the stiff 5 ms contacts already hold the pinch test's box at
     /// its analytic force (+0.02 %) and stop the slope test's creep. Noslip is a projection applied after
     /// the step, and its answers moved with the step: with 10 iterations and 20 ms contacts the
-    /// crimper's fluctuation with feedback went 14 -> 49 -> 68 % at 5 / 2.5 / 1.25 ms (README,
-    /// "Convergence"). Soft 20 ms contacts need it (at 5 ms, 0 iterations left the pinch force
+    /// crimper's fluctuation with feedback went 14 -> 49 -> 68 % at 5 / 2.5 / 1.25 ms
+    /// (docs/studies/convergence.md#what-moves-the-answers-mujocos-noslip-pass). Soft 20 ms contacts need it (at 5 ms, 0 iterations left the pinch force
     /// 6-8 % above m(g+a)/2mu).
     pub noslip_iterations: u32,
     /// No-slip solver tolerance.
@@ -285,7 +284,7 @@ pub struct PhysicsConfig {
     /// the mode a run used).
     pub arm_mode: ArmMode,
     /// The largest joint speed the commanded targets are followed with [rad/s] (the prescribed
-    /// arm's speed, the servos' setpoints'); UR5e maximum 180 deg/s (hardware.md). Targets further
+    /// arm's speed, the servos' setpoints'); UR5e maximum 180 deg/s (docs/facts.md#ur5e-joint-speed). Targets further
     /// away are approached at this speed.
     pub arm_max_speed_rad_s: f64,
     /// Divergence bound: deepest allowed contact penetration \[m\]. 30 mm: a dropped object falls
@@ -358,7 +357,7 @@ impl Validate for PhysicsConfig {
         at.require("contact_solimp", (0.0..1.0).contains(&d0) && (d0..1.0).contains(&dw) && w > 0.0, || {
             format!("needs 0 <= d0 <= dwidth < 1 and width > 0, got {:?}", self.contact_solimp)
         });
-        // The UR5e's joints reach π rad/s (180 °/s, hardware.md); 10 rad/s leaves a margin.
+        // The UR5e's joints reach π rad/s (180 °/s, docs/facts.md#ur5e-joint-speed); 10 rad/s leaves a margin.
         at.in_range("arm_max_speed_rad_s", self.arm_max_speed_rad_s, 1e-3, 10.0);
         // Divergence guards: a penetration of 10 cm is deeper than the objects are wide, and
         // 1 MJ is a car at highway speed; larger guards never trip.
@@ -375,7 +374,7 @@ impl Validate for PhysicsConfig {
 
 /// `[finger]`: the grow-and-twine finger's physical parameters (models/finger.xml is the template).
 ///
-/// Nothing about the real finger's dimensions is published (modeling.md); the values are plausible
+/// Nothing about the real finger's dimensions is published (docs/facts.md#gripper-dimensions-are-unpublished); the values are plausible
 /// choices for a flat TPU strip with a tendon, stated here, and the viscoelastic ones are meant to be
 /// tuned so the twin reproduces the paper's slip times without feedback (crimper ~10 s, shampoo ~13 s,
 /// hammer ~17 s after the arm starts moving).
@@ -387,7 +386,7 @@ pub struct FingerConfig {
     /// from the pad to the tip and 2.2 mm links from the strip's base to the pad, 30 bodies in all.
     /// Its answers agree with 16 and 32 links and with a quarter of the step by the convergence
     /// criteria in 89 of 90 comparisons, and with the uniform 64-link finger's drop times within
-    /// 0.2 s, at 2.5 times its speed (README, "Convergence"; `docs/convergence/`). An object much
+    /// 0.2 s, at 2.5 times its speed (docs/studies/convergence.md#the-uniform-64-link-finger; `docs/convergence/`). An object much
     /// smaller than the paper's (a wrap of under ~4 links per turn) should be checked at links x2
     /// (`tendril chart convergence --quick`). A numerical choice, not a calibration knob.
     pub segments: u32,
@@ -476,7 +475,7 @@ pub struct FingerConfig {
     /// Position-servo damping of both motors [N s/m]; near critical for the armature.
     pub motor_kv_n_s_m: f64,
     /// Largest speed of either motor's output [m/s]: commands further away are approached at this
-    /// speed. MX-106 no-load speed 45 rpm at 12 V (hardware.md) on the 10 mm spool = 0.047 m/s.
+    /// speed. MX-106 no-load speed 45 rpm at 12 V (docs/facts.md#mx-106-speed-and-torque) on the 10 mm spool = 0.047 m/s.
     pub motor_max_speed_m_s: f64,
     /// Largest twine (tendon wound in) \[m\].
     pub twine_max_m: f64,

@@ -6,7 +6,7 @@
 //! about the cell is described twice.
 //!
 //! Settings (`[physics.rapier]`, [`super::RapierConfig`]) follow what was measured for rapier 0.36
-//! on this kind of machine (../shared/reference/modeling.md): the finger is a reduced-coordinate
+//! on this kind of machine (docs/facts.md#rapier-multibody-chain): the finger is a reduced-coordinate
 //! multibody (impulse joints let a 12-link chain drift and drop the object), f64 throughout.
 //!
 //! - [`translate`]: the compiled MuJoCo model -> a rapier world ([`RapierWorld::build`]).

@@ -1,0 +1,6 @@
+//! The scenario key reference, generated from the code (`tendril keys`): [`markdown`].
+
+mod reference;
+pub mod source;
+
+pub use reference::markdown;
