@@ -47,19 +47,15 @@ pub const LIGHT: &[&str] = &[
     "tendril-control",
 ];
 
-/// The crates made to be used on their own (layers 0-2: configuration, kinematics, the sensor
-/// model, the protocols, URScript): `cargo xtask publish-check` packages and builds each as
-/// crates.io would (`cargo publish --dry-run`).
-pub const PUBLISHED: &[&str] = &[
-    "tendril-codec",
-    "tendril-config",
-    "tendril-ur5e",
-    "tendril-fbg",
-    "tendril-rtde",
-    "tendril-dynamixel",
-    "tendril-hyperion",
-    "tendril-urscript",
-];
+/// How many layers, from the bottom, hold the crates made to be used on their own
+/// (configuration, kinematics, the sensor model, the protocols, URScript).
+const PUBLISHED_LAYERS: usize = 3;
+
+/// The crates made to be used on their own: `cargo xtask publish-check` packages and builds each
+/// as crates.io would (`cargo publish --dry-run`).
+pub fn published() -> impl Iterator<Item = &'static str> {
+    LAYERS[..PUBLISHED_LAYERS].iter().flat_map(|layer| layer.iter().copied())
+}
 
 /// What the light crates must not pull in: the physics engines, the async runtime, the video
 /// encoder, the windowing.

@@ -12,7 +12,7 @@
 //! - `cargo xtask book`: build the book in `docs/` into `target/book` with mdBook, installed
 //!   first (the pinned version, from crates.io) into `vendor/mdbook`.
 //! - `cargo xtask publish-check`: `cargo publish --dry-run` of the crates made to be used on their
-//!   own ([`layers::PUBLISHED`]): each is packaged and built from its package alone.
+//!   own ([`layers::published`]): each is packaged and built from its package alone.
 
 mod layers;
 mod modules;
@@ -36,7 +36,7 @@ fn main() -> ExitCode {
         "book" => build_book(rest),
         "publish-check" => run(cargo()
             .args(["publish", "--dry-run"])
-            .args(layers::PUBLISHED.iter().flat_map(|p| ["--package", p]))
+            .args(layers::published().flat_map(|p| ["--package", p]))
             .args(rest)
             .current_dir(workspace_root())),
         _ => {
