@@ -29,8 +29,8 @@ pub const LAYERS: &[&[&str]] = &[
     &["tendril-run"],
     // The virtual devices, the charts.
     &["tendril-serve", "tendril-plot"],
-    // The command line and what only it does.
-    &["tendril"],
+    // The two front ends: the command line (and what only it does), the Python package.
+    &["tendril", "tendril-python"],
 ];
 
 /// Crates that must build without any of [`HEAVY`].

@@ -6,7 +6,8 @@
 //! - `cargo xtask fetch`: unpack MuJoCo 3.17.0 from the PyPI wheel into `vendor/mujoco/lib`.
 //! - `cargo xtask main`: fetch, then run the main job (`tendril reproduce ...`).
 //! - `cargo xtask test`: fetch, install the Python protocol clients into `vendor/venv`, then run
-//!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv.
+//!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv; then build the Python
+//!   package into that venv and run its tests (`python/tests`, pytest).
 //! - `cargo xtask layers`: check the workspace's rules (the crates' layers, the light crates'
 //!   dependencies, no module loops; [`layers`]).
 //! - `cargo xtask book`: build the book in `docs/` into `target/book` with mdBook, installed
@@ -149,12 +150,48 @@ fn run_main(extra: &[String]) -> Result<(), String> {
     run(&mut reproduce)
 }
 
-/// The whole test suite (what `.ci/run` runs).
+/// The whole test suite (what `.ci/run` runs): the workspace's tests, then the Python package's.
 fn run_tests(extra: &[String]) -> Result<(), String> {
     let python = python_clients()?;
-    run(cargo().args(["test", "--workspace", "--all-targets"]).args(extra).env("TENDRIL_PYTHON", &python))?;
+    // The Python extension (a cdylib built by maturin, below) has no Rust tests of its own.
+    let workspace = ["test", "--workspace", "--exclude", "tendril-python"];
+    run(cargo().args(workspace).arg("--all-targets").args(extra).env("TENDRIL_PYTHON", &python))?;
     // The crates' READMEs are their docs, and their samples are doctests (`--all-targets` runs none).
-    run(cargo().args(["test", "--workspace", "--doc"]).args(extra).env("TENDRIL_PYTHON", python))
+    run(cargo().args(workspace).arg("--doc").args(extra).env("TENDRIL_PYTHON", &python))?;
+    python_package_tests(&python)
+}
+
+/// What the Python package's tests need beside the package's own dependencies (numpy and
+/// mujoco, already in the venv): pytest, Gymnasium for the environment, pandas for
+/// `Run.to_pandas`, and maturin, the build backend. Pinned, like the clients.
+const PYTHON_TEST_TOOLS: [&str; 4] = ["pytest==9.2.0", "gymnasium==1.4.0", "pandas==3.1.1", "maturin==1.16.0"];
+
+/// The Python package (pyproject.toml, python/tendril): built and installed into `vendor/venv`
+/// with `pip install .` (the in-tree backend, without build isolation: the venv has maturin and
+/// mujoco), in the `python-test` profile (the tests' optimisation, see Cargo.toml), then
+/// `pytest python/tests`. pytest's exit code 5 (no test collected) fails the task like any other
+/// non-zero exit.
+fn python_package_tests(python: &Path) -> Result<(), String> {
+    let root = workspace_root();
+    let venv = root.join("vendor/venv");
+    let stamp = venv.join(format!("tendril-python-tests-{}", PYTHON_TEST_TOOLS.join("-")));
+    if !stamp.is_file() {
+        eprintln!("xtask: installing {} into {}", PYTHON_TEST_TOOLS.join(", "), venv.display());
+        run(Command::new(python)
+            .args(["-m", "pip", "install", "--quiet", "--only-binary=:all:"])
+            .args(PYTHON_TEST_TOOLS))?;
+        std::fs::write(&stamp, "").map_err(|e| format!("{}: {e}", stamp.display()))?;
+    }
+    run(Command::new(python)
+        .args(["-m", "pip", "install", "--quiet", "--no-build-isolation", "--no-deps", "--force-reinstall", "."])
+        .env("MATURIN_PEP517_ARGS", "--profile python-test")
+        .current_dir(&root))?;
+    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
+    run(Command::new(python)
+        .args(["-m", "pytest", "-q", "python/tests"])
+        // The command line the tests compare runs with: the one `cargo test` just built.
+        .env("TENDRIL_BIN", target.join("debug/tendril"))
+        .current_dir(&root))
 }
 
 /// Independent protocol clients the tests run against the virtual devices (tests/python_clients.rs),

@@ -3,13 +3,26 @@
 
 use super::runner::RunReport;
 use super::scenario::PickPlaceScenario;
-use super::session::Session;
+use super::session::{Action, Session};
 use super::summary::RunSummary;
 use super::trace::TraceWriter;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
-use tendril_cell::Cell;
+use tendril_cell::{Cell, CellError};
+use tendril_control::controller::ForceController;
 use tendril_twin::physics::{SceneModel, SceneSpec};
+
+/// What drives a run besides its scenario ([`run_on_twin_with`]); the default is what
+/// `tendril run` does: the scenario's own controller, every tick to the end.
+#[derive(Default)]
+pub struct Driver<'a> {
+    /// The force controller (`None`: the one the scenario's `[controller]` describes).
+    pub controller: Option<Box<dyn ForceController>>,
+    /// Asked after every tick; an error it returns ends the run with that error (the cell
+    /// deactivated, the outcome `error`): how a controller that cannot fail through
+    /// [`ForceController::update`] reports that it did.
+    pub check: Option<&'a mut (dyn FnMut() -> Option<CellError> + Send)>,
+}
 
 /// Compiled scene models, shared between runs whose scenes are identical (a gain sweep
 /// compiles the model once per object). `MjModel` is `Send + Sync`; each run has its own data.
@@ -41,6 +54,17 @@ pub fn run_on_twin(
     models: &ModelCache,
     out: Option<&Path>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
+    run_on_twin_with(scenario, models, out, Driver::default())
+}
+
+/// As [`run_on_twin`], driven by `driver` (a force controller defined outside the workspace, a
+/// check between ticks).
+pub fn run_on_twin_with(
+    scenario: &PickPlaceScenario,
+    models: &ModelCache,
+    out: Option<&Path>,
+    driver: Driver<'_>,
+) -> anyhow::Result<(RunSummary, RunReport)> {
     let started = super::clock::RunClock::start();
     // Warnings left on this thread by an earlier run are not this run's.
     let _ = tendril_twin::mujoco_log::take_warnings();
@@ -48,7 +72,7 @@ pub fn run_on_twin(
     if out.is_some() {
         cell.record_frames(tendril_twin::frames::RECORD_FPS);
     }
-    let result = run_on_cell(&mut cell, scenario, out, started);
+    let result = run_on_cell_with(&mut cell, scenario, out, started, driver);
     // The frames too when the run failed to write a file: they show what happened.
     if let (Some(dir), Some(frames)) = (out, cell.take_frames())
         && let Err(e) = frames.write(&dir.join(tendril_twin::frames::FRAMES_FILE))
@@ -70,6 +94,17 @@ pub fn run_on_cell(
     out: Option<&Path>,
     started: super::clock::RunClock,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
+    run_on_cell_with(cell, scenario, out, started, Driver::default())
+}
+
+/// As [`run_on_cell`], driven by `driver`.
+pub fn run_on_cell_with(
+    cell: &mut dyn Cell,
+    scenario: &PickPlaceScenario,
+    out: Option<&Path>,
+    started: super::clock::RunClock,
+    driver: Driver<'_>,
+) -> anyhow::Result<(RunSummary, RunReport)> {
     let trace = match out {
         Some(dir) => {
             std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
@@ -82,18 +117,22 @@ pub fn run_on_cell(
         None => None,
     };
     let plan = scenario.control_plan();
-    let mut session = Session::start(&mut *cell, &plan, plan.controller.build(), trace);
-    session.run_to_end();
-    let (mut report, trace) = session.finish();
-    if let Some(push) = &scenario.disturbance.push {
-        let drop_time_s = report.drop.map(|d| d.cell_time_s);
-        report.metrics.max_fluctuation_outside_push_pct =
-            super::metrics::fluctuation_outside_push_pct(&report.rows, drop_time_s, push);
+    let Driver { controller, mut check } = driver;
+    let controller = controller.unwrap_or_else(|| plan.controller.build());
+    let mut session = Session::start(&mut *cell, &plan, controller, trace);
+    match check.as_mut() {
+        None => session.run_to_end(),
+        Some(check) => {
+            while session.step(Action::Controller).is_some() {
+                if let Some(e) = check() {
+                    session.abort(e);
+                    break;
+                }
+            }
+        }
     }
-    let mut summary =
-        RunSummary::new(scenario.identity(cell.backend()), &report, started.wall_s(), started.thread_cpu_s());
-    // The run's own thread stepped its physics (and compiled its model, if not cached).
-    summary.warnings = tendril_twin::mujoco_log::take_warnings();
+    let (mut report, trace) = session.finish();
+    let summary = summarize(scenario, cell.backend(), &mut report, started);
     if let Some(dir) = out {
         // Every file is attempted, and every failure is reported: a trace that could not be
         // written is an error even when summary.json could be.
@@ -111,21 +150,37 @@ pub fn run_on_cell(
     Ok((summary, report))
 }
 
+/// The summary of a finished run of `scenario` on the cell named `backend` (`"mujoco"`, ...), with
+/// the push's metric narrowed when the scenario has one and MuJoCo's warnings on this thread;
+/// `started` is when the run's set-up began. Call it on the thread that ran the run.
+pub fn summarize(
+    scenario: &PickPlaceScenario,
+    backend: &str,
+    report: &mut RunReport,
+    started: super::clock::RunClock,
+) -> RunSummary {
+    if let Some(push) = &scenario.disturbance.push {
+        let drop_time_s = report.drop.map(|d| d.cell_time_s);
+        report.metrics.max_fluctuation_outside_push_pct =
+            super::metrics::fluctuation_outside_push_pct(&report.rows, drop_time_s, push);
+    }
+    let mut summary = RunSummary::new(scenario.identity(backend), report, started.wall_s(), started.thread_cpu_s());
+    // The run's own thread stepped its physics (and compiled its model, if not cached).
+    summary.warnings = tendril_twin::mujoco_log::take_warnings();
+    summary
+}
+
 /// Writes `summary.json` with the effective scenario under `"effective_scenario"` (every key after the
 /// defaults, the file and the `--set` overrides: what tools read to know the timestep, links,
 /// gains... a run used), and that scenario again as `scenario.toml`, which `tendril run` takes
 /// as it is to repeat the run from its own directory.
 pub fn write_summary(dir: &Path, summary: &RunSummary, scenario: &PickPlaceScenario) -> anyhow::Result<()> {
-    let mut record = serde_json::to_value(summary)?;
-    if let serde_json::Value::Object(fields) = &mut record {
-        fields.insert("effective_scenario".into(), serde_json::to_value(scenario)?);
-    }
     // Atomically: a failed write (a full disk) keeps the previous file whole.
     let write = |path: &Path, text: &str| {
         tendril_config::write_atomically(path, text.as_bytes())
             .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write: {e}", file.display()))
     };
-    write(&dir.join("summary.json"), &(serde_json::to_string_pretty(&record)? + "\n"))?;
+    write(&dir.join("summary.json"), &summary_json(summary, scenario)?)?;
     let path = dir.join("scenario.toml");
     let text = toml::to_string(scenario).map_err(|e| anyhow::anyhow!("{}: cannot encode: {e}", path.display()))?;
     write(
@@ -134,4 +189,13 @@ pub fn write_summary(dir: &Path, summary: &RunSummary, scenario: &PickPlaceScena
             "# The effective scenario of this run (defaults, file and --set applied): `tendril run` repeats it.\n{text}"
         ),
     )
+}
+
+/// The text of `summary.json`: `summary` with the effective scenario under `"effective_scenario"`.
+pub fn summary_json(summary: &RunSummary, scenario: &PickPlaceScenario) -> anyhow::Result<String> {
+    let mut record = serde_json::to_value(summary)?;
+    if let serde_json::Value::Object(fields) = &mut record {
+        fields.insert("effective_scenario".into(), serde_json::to_value(scenario)?);
+    }
+    Ok(serde_json::to_string_pretty(&record)? + "\n")
 }

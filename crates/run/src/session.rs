@@ -212,6 +212,22 @@ impl<C: Cell> Session<C> {
         self.sequencer.feedback()
     }
 
+    /// The object's loss as ground truth saw it so far (`None`: still held, or a cell without
+    /// ground truth): what a caller stepping the run watches for (a learning environment ends an
+    /// episode on it).
+    pub fn dropped(&self) -> Option<Drop> {
+        self.truth_drop
+    }
+
+    /// Ends the run with `error` (a controller defined outside the crate that failed, say): no
+    /// further tick runs, and [`Session::finish`] deactivates the cell and reports the run as an
+    /// [`Outcome::Error`] with this error.
+    pub fn abort(&mut self, error: CellError) {
+        if self.error.is_none() {
+            self.fail(error);
+        }
+    }
+
     fn fail(&mut self, e: CellError) {
         self.error = Some(e);
         self.over = true;

@@ -1,0 +1,181 @@
+//! [`Session`]: one run on the twin stepped from Python, tick by tick (what `tendril.env.GripEnv`
+//! drives): observe, act (the scenario's controller, a twine speed, or a setpoint), repeat.
+
+use crate::columns::row_dict;
+use crate::errors::run_error;
+use crate::models::ModelCache;
+use crate::scenario::Scenario;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::{Mutex, PoisonError};
+use tendril_cell::{Cell, Phase};
+use tendril_run::clock::RunClock;
+use tendril_run::execute::{summarize, summary_json};
+use tendril_run::scenario::PickPlaceScenario;
+use tendril_run::session::{Action, Observation};
+use tendril_twin::sim::SimCell;
+
+/// The task's phases in order: an observation's `phase_index` is the position in this list.
+pub const PHASES: [Phase; 9] = [
+    Phase::Home,
+    Phase::Grow,
+    Phase::Wrap,
+    Phase::Grasp,
+    Phase::Lift,
+    Phase::Transfer,
+    Phase::Lower,
+    Phase::Release,
+    Phase::Done,
+];
+
+/// A run in progress, or the summary it left.
+struct State {
+    session: Option<tendril_run::session::Session<SimCell>>,
+    backend: String,
+    started: RunClock,
+    summary: Option<String>,
+}
+
+/// One run of a scenario on the twin, stepped by the caller. Started at construction (the cell
+/// configured and activated, the first tick read); `finish()` deactivates the cell and returns
+/// `summary.json`'s text.
+#[pyclass(frozen, module = "tendril._native")]
+pub struct Session {
+    scenario: PickPlaceScenario,
+    max_speed_deg_s: f64,
+    state: Mutex<State>,
+}
+
+#[pymethods]
+impl Session {
+    /// Starts a run of `scenario`, its scene model taken from `models` (compiled there on first use).
+    #[new]
+    #[pyo3(signature = (scenario, models = None))]
+    fn new(py: Python<'_>, scenario: &Scenario, models: Option<&ModelCache>) -> PyResult<Session> {
+        let scenario = scenario.scenario.clone();
+        let own = ModelCache::default();
+        let models = models.unwrap_or(&own);
+        let controller = scenario.controller.build();
+        let max_speed_deg_s = controller.max_speed_deg_s();
+        let state = py.detach(|| -> anyhow::Result<State> {
+            let started = RunClock::start();
+            let _ = tendril_twin::mujoco_log::take_warnings();
+            let cell = scenario.sim_cell(models.inner.get(&scenario.scene_spec())?);
+            let backend = cell.backend().to_string();
+            let plan = scenario.control_plan();
+            let session = tendril_run::session::Session::start(cell, &plan, controller, None);
+            Ok(State { session: Some(session), backend, started, summary: None })
+        });
+        Ok(Session { scenario, max_speed_deg_s, state: Mutex::new(state.map_err(run_error)?) })
+    }
+
+    /// The largest twine speed the controller commands [°/s]: a `twine_speed_deg_s` action is
+    /// clamped to ± this.
+    #[getter]
+    fn max_speed_deg_s(&self) -> f64 {
+        self.max_speed_deg_s
+    }
+
+    /// Whether the run is over (task done, or stopped by an error): no further tick runs.
+    #[getter]
+    fn is_over(&self) -> bool {
+        self.lock().session.as_ref().is_none_or(|s| s.is_over())
+    }
+
+    /// The latest reading, which the next `step` acts on, as a dict (`None` once the run is over):
+    /// `time_s`, `phase`, `phase_index`, `fbg1_nm`, `fbg2_nm`, `delta1_pm` and `delta2_pm` (the
+    /// gratings' shifts from the tare), `force_n`, `force_uncompensated_n`, `over_range`,
+    /// `setpoint_n`, `time_to_motion_s`, `arm_q_rad`, `growth_motor_rad`, `twine_motor_rad`,
+    /// `tool_load_n` and `truth` (the ground truth: `sensor_force_n`, `grip_force_n`,
+    /// `object_height_m`, `slip_speed_m_s`, `in_contact`).
+    fn observation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let seen = self.lock().session.as_ref().and_then(|s| s.observation());
+        seen.map(|o| observation_dict(py, &o)).transpose()
+    }
+
+    /// Runs one tick: the scenario's controller acts, or `twine_speed_deg_s` replaces its output
+    /// (clamped to ±`max_speed_deg_s`) in the phases where it would act, or it acts on
+    /// `setpoint_n` instead of the scenario's setpoint. Returns the tick's trace row as a dict
+    /// (`None` once the run is over).
+    #[pyo3(signature = (twine_speed_deg_s = None, setpoint_n = None))]
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        twine_speed_deg_s: Option<f64>,
+        setpoint_n: Option<f64>,
+    ) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let action = match (twine_speed_deg_s, setpoint_n) {
+            (None, None) => Action::Controller,
+            (Some(v), None) if v.is_finite() => Action::TwineSpeed(v),
+            (None, Some(v)) if v.is_finite() => Action::Setpoint(v),
+            (Some(_), Some(_)) => {
+                return Err(PyValueError::new_err("step: give twine_speed_deg_s or setpoint_n, not both"));
+            }
+            _ => return Err(PyValueError::new_err("step: the action must be a finite number")),
+        };
+        let row = py.detach(|| self.lock().session.as_mut().and_then(|s| s.step(action)));
+        row.map(|r| row_dict(py, &r)).transpose()
+    }
+
+    /// When ground truth saw the object lost, as `(cell_time_s, phase)` (`None`: not lost).
+    fn dropped(&self) -> Option<(f64, &'static str)> {
+        self.lock().session.as_ref().and_then(|s| s.dropped()).map(|d| (d.cell_time_s, d.phase.name()))
+    }
+
+    /// Ends the run (the cell deactivated, whatever happened) and returns `summary.json`'s text;
+    /// called again, returns the same text.
+    fn finish(&self, py: Python<'_>) -> PyResult<String> {
+        py.detach(|| {
+            let mut state = self.lock();
+            if let Some(session) = state.session.take() {
+                let (mut report, _) = session.finish();
+                let summary = summarize(&self.scenario, &state.backend, &mut report, state.started);
+                state.summary = Some(summary_json(&summary, &self.scenario)?);
+            }
+            Ok(state.summary.clone().unwrap_or_default())
+        })
+        .map_err(run_error)
+    }
+}
+
+impl Session {
+    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// An observation as a dict (see [`Session::observation`]).
+fn observation_dict<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("time_s", o.time_s)?;
+    d.set_item("phase", o.phase.name())?;
+    d.set_item("phase_index", PHASES.iter().position(|p| *p == o.phase))?;
+    d.set_item("fbg1_nm", o.wavelengths.fbg1_nm)?;
+    d.set_item("fbg2_nm", o.wavelengths.fbg2_nm)?;
+    d.set_item("delta1_pm", o.estimate.delta1_pm)?;
+    d.set_item("delta2_pm", o.estimate.delta2_pm)?;
+    d.set_item("force_n", o.estimate.force_n)?;
+    d.set_item("force_uncompensated_n", o.estimate.uncompensated_n)?;
+    d.set_item("over_range", o.estimate.over_range)?;
+    d.set_item("setpoint_n", o.setpoint_n)?;
+    d.set_item("time_to_motion_s", o.time_to_motion_s)?;
+    d.set_item("arm_q_rad", o.state.arm_q)?;
+    d.set_item("growth_motor_rad", o.state.growth_motor_rad)?;
+    d.set_item("twine_motor_rad", o.state.twine_motor_rad)?;
+    d.set_item("tool_load_n", o.state.tool_load_n)?;
+    let truth = match &o.truth {
+        None => None,
+        Some(t) => {
+            let td = PyDict::new(py);
+            td.set_item("sensor_force_n", t.sensor_force_n)?;
+            td.set_item("grip_force_n", t.grip_force_n)?;
+            td.set_item("object_height_m", t.object_height_m)?;
+            td.set_item("slip_speed_m_s", t.slip_speed_m_s)?;
+            td.set_item("in_contact", t.in_contact)?;
+            Some(td)
+        }
+    };
+    d.set_item("truth", truth)?;
+    Ok(d)
+}

@@ -1,0 +1,178 @@
+"""``GripEnv`` (Gymnasium id ``tendril/Grip-v0``): the grasp-and-carry task as a learning
+environment, one episode a run of a scenario on the twin.
+
+Each step is one control tick (10 ms at the default 100 Hz). The task runs as ``tendril run``
+runs it (home, grow, wrap, grasp, lift, transfer, lower, release); the agent's action replaces the
+force controller's output in the phases where the controller acts (the grasp, and the arm's moves
+when ``feedback`` is on), and is ignored in the others.
+
+Action
+    ``Box(-1, 1, (1,), float32)``: the twine motor speed as a fraction of the controller's speed
+    limit (``controller.max_speed_deg_s``, 90 °/s with the paper's PID); positive tightens.
+
+Observation
+    ``Box(float32, (6,))``: ``[Δλ1, Δλ2, F, F*, phase, τ]``: the shifts of FBG1 and FBG2 from their
+    tare [pm] (the sensor's raw signal; FBG2 moves only with temperature), the force estimate F
+    (eq. 8) [N], the setpoint F* [N], the phase's index in ``tendril.PHASES`` (0 home ... 8 done),
+    and the time to the arm's next move τ [s] (capped at ``max_time_to_motion_s``; 0 while it
+    moves). Non-finite values (an invalid sample) read as 0.
+
+Reward
+    ``-|F - F*|`` [N] on each tick where the controller acts (0 on the others), the sensor's
+    estimate against the setpoint, as the paper's controller sees it; minus ``drop_penalty`` (100)
+    on the tick the object is lost.
+
+End
+    ``terminated`` when the task is done or the object is lost (ground truth: out of contact for
+    0.3 s, or slid 20 mm in the hand); ``truncated`` when the cell stops on an error (a physics
+    failure), with the error in ``info["error"]``.
+
+Info
+    ``time_s``, ``phase``, the ground truth (``true_force_n``, ``grip_force_n``,
+    ``object_height_m``, ``slip_speed_m_s``, ``in_contact``), ``dropped``; at the end also
+    ``summary`` (``summary.json``'s content).
+
+``reset(seed=..., options={"set": {...}})``: the seed is the scenario's (the sensor noise);
+without one, a seed is drawn from the environment's generator. ``options["set"]`` overrides
+scenario keys for that episode, after the ``set`` given at construction.
+"""
+
+import json
+import math
+import os
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from . import PHASES, ModelCache, Session, load
+
+#: The scenario an environment runs unless given another: the crimper's short grasp-and-lift
+#: (a copy of the repository's ``scenarios/short-lift.toml``, about 15 s of cell time).
+DEFAULT_SCENARIO = os.path.join(os.path.dirname(__file__), "scenarios", "short-lift.toml")
+
+
+class GripEnv(gymnasium.Env):
+    """The grasp-and-carry task on the twin (see the module's documentation)."""
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, scenario=None, set=None, overlay=None, drop_penalty=100.0, max_time_to_motion_s=10.0):
+        self._path = os.fspath(scenario) if scenario is not None else DEFAULT_SCENARIO
+        self._set = _as_dict(set)
+        self._overlay = overlay
+        self.drop_penalty = float(drop_penalty)
+        self.max_time_to_motion_s = float(max_time_to_motion_s)
+        self._models = ModelCache()
+        self._session = None
+        # Checked now: a bad scenario fails at construction, not at the first reset.
+        self._scenario = load(self._path, self._set, self._overlay)
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+        low = np.array([-1e4, -1e4, -20.0, 0.0, 0.0, 0.0], dtype=np.float32)
+        high = np.array([1e4, 1e4, 20.0, 20.0, len(PHASES) - 1, self.max_time_to_motion_s], dtype=np.float32)
+        self.observation_space = spaces.Box(low, high, dtype=np.float32)
+        self._last_obs = np.zeros(6, dtype=np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self._end()
+        overrides = dict(self._set)
+        overrides.update(_as_dict((options or {}).get("set")))
+        # The twin's seed: the one given, else drawn from the environment's generator (seeded by
+        # an earlier reset(seed=...)), so every episode differs and a seeded sequence repeats.
+        overrides["seed"] = int(seed) if seed is not None else int(self.np_random.integers(0, 2**63 - 1))
+        self._scenario = load(self._path, overrides, self._overlay)
+        self._session = Session(self._scenario, self._models)
+        self._dropped = False
+        seen = self._session.observation()
+        if seen is None:
+            summary = json.loads(self._session.finish())
+            raise RuntimeError(f"the run could not start: {summary.get('error')}")
+        self._last_obs = self._observe(seen)
+        return self._last_obs, self._info(seen, None)
+
+    def step(self, action):
+        if self._session is None:
+            raise RuntimeError("step() before reset(), or after the episode ended: call reset()")
+        a = float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
+        if not math.isfinite(a):
+            raise ValueError(f"the action must be finite, got {a}")
+        speed = float(np.clip(a, -1.0, 1.0)) * self._session.max_speed_deg_s
+        row = self._session.step(twine_speed_deg_s=speed)
+        if row is None:
+            # The run was already over (an error on the last read): nothing ran.
+            return self._last_obs, 0.0, False, True, self._finish({})
+        reward = -abs(row["force_n"] - row["setpoint_n"]) if row["controller_on"] else 0.0
+        if not self._dropped and self._session.dropped() is not None:
+            self._dropped = True
+            reward -= self.drop_penalty
+        seen = self._session.observation()
+        if seen is not None:
+            self._last_obs = self._observe(seen)
+        info = self._info(seen, row)
+        terminated = self._dropped or row["phase"] == "done"
+        truncated = not terminated and self._session.is_over
+        if terminated or truncated:
+            info = self._finish(info)
+        return self._last_obs, float(reward), terminated, truncated, info
+
+    def close(self):
+        self._end()
+
+    def _observe(self, seen):
+        ttm = seen["time_to_motion_s"]
+        values = [
+            seen["delta1_pm"],
+            seen["delta2_pm"],
+            seen["force_n"],
+            seen["setpoint_n"],
+            seen["phase_index"],
+            min(ttm, self.max_time_to_motion_s) if not math.isnan(ttm) else 0.0,
+        ]
+        obs = np.nan_to_num(np.array(values, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+        return np.clip(obs, self.observation_space.low, self.observation_space.high).astype(np.float32)
+
+    def _info(self, seen, row):
+        info = {"dropped": self._dropped}
+        if seen is not None:
+            info["time_s"] = seen["time_s"]
+            info["phase"] = seen["phase"]
+            truth = seen["truth"] or {}
+            info["true_force_n"] = truth.get("sensor_force_n", math.nan)
+            for key in ("grip_force_n", "object_height_m", "slip_speed_m_s", "in_contact"):
+                info[key] = truth.get(key)
+        elif row is not None:
+            info["time_s"] = row["time_s"]
+            info["phase"] = row["phase"]
+            info["true_force_n"] = row["true_force_n"]
+            for key in ("grip_force_n", "object_height_m", "slip_speed_m_s"):
+                info[key] = row[key]
+        return info
+
+    def _finish(self, info):
+        summary = json.loads(self._session.finish())
+        self._session = None
+        info["summary"] = summary
+        if summary.get("error"):
+            info["error"] = summary["error"]
+        return info
+
+    def _end(self):
+        if self._session is not None:
+            self._session.finish()
+            self._session = None
+
+
+def _as_dict(set):
+    """``set`` as a dict of overrides (a list of ``"key=value"`` strings is split)."""
+    if set is None:
+        return {}
+    if isinstance(set, dict):
+        return dict(set)
+    out = {}
+    for item in set:
+        key, sep, value = str(item).partition("=")
+        if not sep:
+            raise ValueError(f"set: expected \"key=value\", got {item!r}")
+        out[key.strip()] = value.strip()
+    return out

@@ -1,0 +1,113 @@
+"""tendril.run and run_many: the command line's runs, from Python."""
+
+import json
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import tendril
+from conftest import SHORT_LIFT, without_timing
+
+
+@pytest.fixture(scope="module")
+def cli_and_python(tendril_bin, tmp_path_factory):
+    """The same scenario and seed run by `tendril run` and by tendril.run, each into a folder."""
+    cli_dir = tmp_path_factory.mktemp("cli")
+    py_dir = tmp_path_factory.mktemp("py")
+    subprocess.run(
+        [tendril_bin, "run", str(SHORT_LIFT), "--seed", "3", "--feedback", "off", "--out", str(cli_dir)],
+        check=True,
+        capture_output=True,
+    )
+    run = tendril.run(SHORT_LIFT, seed=3, feedback="off", out=py_dir)
+    return cli_dir, py_dir, run
+
+
+def test_the_files_equal_the_command_lines(cli_and_python):
+    cli_dir, py_dir, _ = cli_and_python
+    assert (py_dir / "trace.csv").read_bytes() == (cli_dir / "trace.csv").read_bytes()
+    cli = json.loads((cli_dir / "summary.json").read_text())
+    py = json.loads((py_dir / "summary.json").read_text())
+    assert without_timing(py) == without_timing(cli)
+    assert (py_dir / "scenario.toml").read_bytes() == (cli_dir / "scenario.toml").read_bytes()
+    assert (py_dir / "frames.bin").read_bytes() == (cli_dir / "frames.bin").read_bytes()
+
+
+def test_the_summary_and_the_trace_are_the_runs(cli_and_python):
+    cli_dir, _, run = cli_and_python
+    cli = json.loads((cli_dir / "summary.json").read_text())
+    assert without_timing(run.summary) == without_timing(cli)
+    assert run.outcome == run.summary["outcome"] == "held"
+    assert list(run.trace) == list(tendril.TRACE_COLUMNS)
+    header = (cli_dir / "trace.csv").read_text().splitlines()[0].split(",")
+    assert list(run.trace) == header
+    csv = np.genfromtxt(cli_dir / "trace.csv", delimiter=",", names=True, dtype=None, encoding="utf-8")
+    assert len(run) == len(csv)
+    for name in ("time_s", "force_n", "fbg1_nm", "twine_motor_rad", "grip_force_n"):
+        assert run.trace[name].dtype == np.float64
+        np.testing.assert_allclose(run.trace[name], csv[name], atol=1e-3, err_msg=name)
+    assert list(run.trace["phase"]) == list(csv["phase"])
+    assert run.trace["controller_on"].dtype == bool
+    np.testing.assert_array_equal(run.trace["controller_on"], csv["controller_on"].astype(bool))
+
+
+def test_to_pandas_is_the_trace(cli_and_python):
+    _, _, run = cli_and_python
+    frame = run.to_pandas()
+    assert list(frame.columns) == list(run.trace)
+    assert len(frame) == len(run)
+    assert frame["phase"].iloc[-1] == "done"
+
+
+def test_a_loaded_scenario_runs_as_its_path_does():
+    scenario = tendril.load(SHORT_LIFT, set={"seed": 5})
+    by_scenario = tendril.run(scenario)
+    by_path = tendril.run(SHORT_LIFT, seed=5)
+    assert without_timing(by_scenario.summary) == without_timing(by_path.summary)
+    np.testing.assert_array_equal(by_scenario.trace["force_n"], by_path.trace["force_n"])
+
+
+def test_run_many_gives_the_runs_one_by_one_would_in_order():
+    scenarios = [tendril.load(SHORT_LIFT, set={"seed": s}) for s in (1, 2)]
+    many = tendril.run_many(scenarios, threads=2)
+    assert [r.summary["seed"] for r in many] == [1, 2]
+    alone = tendril.run(scenarios[1])
+    assert without_timing(many[1].summary) == without_timing(alone.summary)
+    np.testing.assert_array_equal(many[1].trace["force_n"], alone.trace["force_n"])
+    with pytest.raises(ValueError, match="threads"):
+        tendril.run_many(scenarios, threads=0)
+
+
+def test_a_run_lets_other_python_threads_go_on():
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(1)
+            stop.wait(0.001)
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    try:
+        tendril.run(SHORT_LIFT)
+    finally:
+        stop.set()
+        counter.join()
+    # With the GIL held for the whole run the counter would have run only before and after.
+    assert len(ticks) > 50
+
+
+def test_bad_arguments_are_named():
+    with pytest.raises(ValueError, match="unknown physics backend `bullet`"):
+        tendril.run(SHORT_LIFT, backend="bullet")
+    with pytest.raises(ValueError, match="feedback"):
+        tendril.run(SHORT_LIFT, feedback="sometimes")
+    with pytest.raises(ValueError, match="seed"):
+        tendril.run(SHORT_LIFT, seed=-1)
+    with pytest.raises(TypeError, match="scenario"):
+        tendril.run(42)
+    with pytest.raises(tendril.ScenarioError):
+        tendril.run(SHORT_LIFT.with_name("none.toml"))
