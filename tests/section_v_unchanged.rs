@@ -2,7 +2,8 @@
 //! Section V runs (crimper, shampoo and hammer, feedback on and off, seed 1) write the same
 //! `trace.csv` bytes and the same `summary.json`, but for its timing fields, as main 67179d3 did
 //! before the move. `tests/fixtures/section_v_67179d3.json` holds, per run, the sha256 of that
-//! commit's trace and its summary without the timing fields.
+//! commit's trace and its summary without the timing fields, the checkout's own folder (which the
+//! summary's resolved paths name) written as `<checkout>`.
 //!
 //! A change that means to move the twin's answers (a new contact model, a new default) fails here;
 //! its commit rewrites the fixture from the new binary's runs and says why in its message.
@@ -30,7 +31,10 @@ fn run(object: &str, feedback: &str, out: &Path) -> (Vec<u8>, serde_json::Value)
         .unwrap();
     assert!(result.status.success(), "{object} {feedback}: {}", String::from_utf8_lossy(&result.stderr));
     let trace = std::fs::read(out.join("trace.csv")).unwrap();
-    let summary = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // The object file and the models folder are resolved to absolute paths in this checkout.
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let text = text.replace(concat!(env!("CARGO_MANIFEST_DIR"), "/"), "<checkout>/");
+    let summary = serde_json::from_str(&text).unwrap();
     (trace, summary)
 }
 
