@@ -18,9 +18,22 @@ Observation
     moves). Non-finite values (an invalid sample) read as 0.
 
 Reward
-    ``-|F - F*|`` [N] on each tick where the controller acts (0 on the others), the sensor's
-    estimate against the setpoint, as the paper's controller sees it; minus ``drop_penalty`` (100)
-    on the tick the object is lost.
+    Per tick of ``dt`` seconds (the control tick), with F the force estimate (eq. 8, what the
+    paper's metrics read), F* the setpoint and e = |F - F*| / F* the relative error:
+
+    - ``+ hold_reward * dt`` while the object is in the hand (grasp, lift, transfer, lower) and
+      not lost: 1 per second held;
+    - ``- band_weight * max(0, e - band) * dt`` on the ticks the controller acts: force beyond the
+      setpoint band (``band`` = 0.1, the ±10 % band of the paper's oscillation check), 5 per
+      unit of relative error beyond it per second;
+    - ``- fluctuation_weight * e * dt`` while the arm moves (lift, transfer, lower): the paper's
+      "fluctuation while moving" (``max_fluctuation_pct`` in the summary) as a running cost, 2 per
+      unit of relative error per second;
+    - ``- drop_penalty`` (100, a hundred seconds of holding) on the tick the object is lost.
+
+    The constants are the constructor's arguments of the same names. They are stated choices, not
+    fitted: holding dominates (a drop costs more than any grip earns in a paper task of 43.5 s),
+    and the force terms rank grips that hold by the paper's two force metrics.
 
 End
     ``terminated`` when the task is done or the object is lost (ground truth: out of contact for
@@ -47,6 +60,22 @@ from gymnasium import spaces
 
 from . import PHASES, ModelCache, Session, load
 
+#: Reward for each second the object is in the hand (see the module's documentation).
+HOLD_REWARD = 1.0
+#: Half-width of the setpoint band, as a fraction of the setpoint (the ±10 % of the paper's
+#: oscillation check, ``crates/run/src/metrics.rs``).
+BAND = 0.1
+#: Cost of force beyond the band, per unit of relative error per second.
+BAND_WEIGHT = 5.0
+#: Cost of the relative error while the arm moves, per unit per second.
+FLUCTUATION_WEIGHT = 2.0
+#: Cost of losing the object: a hundred seconds of holding.
+DROP_PENALTY = 100.0
+#: Phases in which the object is in the hand.
+HOLDING_PHASES = ("grasp", "lift", "transfer", "lower")
+#: Phases in which the arm moves with the object.
+MOVING_PHASES = ("lift", "transfer", "lower")
+
 #: The scenario an environment runs unless given another: the crimper's short grasp-and-lift
 #: (a copy of the repository's ``scenarios/short-lift.toml``, about 15 s of cell time).
 DEFAULT_SCENARIO = os.path.join(os.path.dirname(__file__), "scenarios", "short-lift.toml")
@@ -57,11 +86,26 @@ class GripEnv(gymnasium.Env):
 
     metadata = {"render_modes": []}
 
-    def __init__(self, scenario=None, set=None, overlay=None, drop_penalty=100.0, max_time_to_motion_s=10.0):
+    def __init__(
+        self,
+        scenario=None,
+        set=None,
+        overlay=None,
+        drop_penalty=DROP_PENALTY,
+        hold_reward=HOLD_REWARD,
+        band=BAND,
+        band_weight=BAND_WEIGHT,
+        fluctuation_weight=FLUCTUATION_WEIGHT,
+        max_time_to_motion_s=10.0,
+    ):
         self._path = os.fspath(scenario) if scenario is not None else DEFAULT_SCENARIO
         self._set = _as_dict(set)
         self._overlay = overlay
         self.drop_penalty = float(drop_penalty)
+        self.hold_reward = float(hold_reward)
+        self.band = float(band)
+        self.band_weight = float(band_weight)
+        self.fluctuation_weight = float(fluctuation_weight)
         self.max_time_to_motion_s = float(max_time_to_motion_s)
         self._models = ModelCache()
         self._session = None
@@ -102,10 +146,9 @@ class GripEnv(gymnasium.Env):
         if row is None:
             # The run was already over (an error on the last read): nothing ran.
             return self._last_obs, 0.0, False, True, self._finish({})
-        reward = -abs(row["force_n"] - row["setpoint_n"]) if row["controller_on"] else 0.0
-        if not self._dropped and self._session.dropped() is not None:
-            self._dropped = True
-            reward -= self.drop_penalty
+        was_dropped = self._dropped
+        self._dropped = self._dropped or self._session.dropped() is not None
+        reward = self._reward(row, lost_now=self._dropped and not was_dropped)
         seen = self._session.observation()
         if seen is not None:
             self._last_obs = self._observe(seen)
@@ -118,6 +161,24 @@ class GripEnv(gymnasium.Env):
 
     def close(self):
         self._end()
+
+    def _reward(self, row, lost_now):
+        """The tick's reward (see the module's documentation)."""
+        if lost_now:
+            return -self.drop_penalty
+        if self._dropped:
+            return 0.0
+        dt = self._session.dt_s
+        setpoint = row["setpoint_n"]
+        error = abs(row["force_n"] - setpoint) / setpoint if setpoint > 0.0 and math.isfinite(row["force_n"]) else 0.0
+        reward = 0.0
+        if row["phase"] in HOLDING_PHASES:
+            reward += self.hold_reward * dt
+        if row["controller_on"]:
+            reward -= self.band_weight * max(0.0, error - self.band) * dt
+        if row["phase"] in MOVING_PHASES:
+            reward -= self.fluctuation_weight * error * dt
+        return reward
 
     def _observe(self, seen):
         ttm = seen["time_to_motion_s"]

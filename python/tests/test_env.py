@@ -41,7 +41,8 @@ def test_an_episode_runs_to_the_end_of_the_task():
     assert {"grasp", "lift"} <= phases
     assert info["summary"]["outcome"] == "held"
     assert not info["dropped"]
-    assert total < 0.0 and steps > 500
+    # Held through the grasp and the lift (about 6 s): the holding reward outweighs the force terms.
+    assert 3.0 < total < 7.0 and steps > 500
     with pytest.raises(RuntimeError, match="reset"):
         env.step(np.zeros(1, dtype=np.float32))
     env.close()

@@ -77,6 +77,12 @@ impl Session {
         self.max_speed_deg_s
     }
 
+    /// The control tick \[s\]: one `step` advances the cell by this much (1 / `control_rate_hz`).
+    #[getter]
+    fn dt_s(&self) -> f64 {
+        1.0 / self.scenario.control_rate_hz
+    }
+
     /// Whether the run is over (task done, or stopped by an error): no further tick runs.
     #[getter]
     fn is_over(&self) -> bool {
