@@ -12,10 +12,13 @@ class Run:
     effective scenario under ``"effective_scenario"``). ``trace``: one numpy array per
     ``trace.csv`` column, in its order, at full precision (the file rounds to 3-5 decimals);
     ``phase`` holds the phases' names, ``over_range`` and ``controller_on`` are booleans.
+    ``controller_times``: with a Python controller, how long its ``update`` calls took (``calls``,
+    ``mean_ms``, ``max_ms``, ``over_tick``: calls longer than the tick, ``tick_ms``); else ``None``.
     """
 
-    def __init__(self, summary_json, columns):
+    def __init__(self, summary_json, columns, controller_times=None):
         self.summary = json.loads(summary_json)
+        self.controller_times = controller_times
         self.trace = {}
         for name, kind, data in columns:
             if kind == "f8":

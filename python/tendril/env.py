@@ -45,6 +45,16 @@ Info
     ``object_height_m``, ``slip_speed_m_s``, ``in_contact``), ``dropped``; at the end also
     ``summary`` (``summary.json``'s content).
 
+Render
+    ``render_mode="rgb_array"``: ``render()`` returns the scene as MuJoCo's offscreen renderer
+    draws it (as ``tendril render`` does: the free camera on the object, the pad in orange, the
+    contact forces as arrows), a ``(render_height, render_width, 3)`` uint8 array. It needs an
+    EGL driver (Mesa's ``libegl1 libgl1-mesa-dri`` on Debian/Ubuntu).
+
+Vector
+    ``gymnasium.make_vec("tendril/Grip-v0", num_envs=N)`` makes a
+    :class:`tendril.vector.GripVectorEnv`: N twins stepped in parallel in Rust, the GIL released.
+
 ``reset(seed=..., options={"set": {...}})``: the seed is the scenario's (the sensor noise);
 without one, a seed is drawn from the environment's generator. ``options["set"]`` overrides
 scenario keys for that episode, after the ``set`` given at construction.
@@ -58,7 +68,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from . import PHASES, ModelCache, Session, load
+from . import PHASES, ModelCache, Renderer, Session, load
 
 #: Reward for each second the object is in the hand (see the module's documentation).
 HOLD_REWARD = 1.0
@@ -84,7 +94,7 @@ DEFAULT_SCENARIO = os.path.join(os.path.dirname(__file__), "scenarios", "short-l
 class GripEnv(gymnasium.Env):
     """The grasp-and-carry task on the twin (see the module's documentation)."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
     def __init__(
         self,
@@ -97,7 +107,17 @@ class GripEnv(gymnasium.Env):
         band_weight=BAND_WEIGHT,
         fluctuation_weight=FLUCTUATION_WEIGHT,
         max_time_to_motion_s=10.0,
+        render_mode=None,
+        render_width=640,
+        render_height=480,
+        models=None,
     ):
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode: expected None or 'rgb_array', got {render_mode!r}")
+        self.render_mode = render_mode
+        self._render_size = (int(render_width), int(render_height))
+        self._renderer = None
+        self._last_frame = None
         self._path = os.fspath(scenario) if scenario is not None else DEFAULT_SCENARIO
         self._set = _as_dict(set)
         self._overlay = overlay
@@ -107,7 +127,8 @@ class GripEnv(gymnasium.Env):
         self.band_weight = float(band_weight)
         self.fluctuation_weight = float(fluctuation_weight)
         self.max_time_to_motion_s = float(max_time_to_motion_s)
-        self._models = ModelCache()
+        # Compiled scene models, shared with other environments when given (a vector of them).
+        self._models = models if models is not None else ModelCache()
         self._session = None
         # Checked now: a bad scenario fails at construction, not at the first reset.
         self._scenario = load(self._path, self._set, self._overlay)
@@ -116,6 +137,11 @@ class GripEnv(gymnasium.Env):
         high = np.array([1e4, 1e4, 20.0, 20.0, len(PHASES) - 1, self.max_time_to_motion_s], dtype=np.float32)
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self._last_obs = np.zeros(6, dtype=np.float32)
+        # The control tick [s]: the render rate and the reward's time unit.
+        self.metadata = dict(self.metadata, render_fps=round(1.0 / self._scenario_tick_s()))
+
+    def _scenario_tick_s(self):
+        return 1.0 / float(self._scenario.to_dict().get("control_rate_hz", 100.0))
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
@@ -136,13 +162,36 @@ class GripEnv(gymnasium.Env):
         return self._last_obs, self._info(seen, None)
 
     def step(self, action):
+        speed = self._twine_speed(action)
+        return self._after_step(self._session.step(twine_speed_deg_s=speed))
+
+    def render(self):
+        """The scene now, as a ``(height, width, 3)`` uint8 array (``render_mode="rgb_array"``);
+        ``None`` without a render mode. After the episode's end, its last picture."""
+        if self.render_mode is None:
+            return None
+        if self._session is None:
+            return self._last_frame
+        if self._renderer is None or not self._renderer.draws(self._session):
+            width, height = self._render_size
+            self._renderer = Renderer(self._session, width=width, height=height)
+        rgb = self._renderer.render(self._session)
+        if rgb is not None:
+            width, height = self._render_size
+            self._last_frame = np.frombuffer(rgb, dtype=np.uint8).reshape(height, width, 3)
+        return self._last_frame
+
+    def _twine_speed(self, action):
+        """The twine speed [°/s] an action in [-1, 1] stands for."""
         if self._session is None:
             raise RuntimeError("step() before reset(), or after the episode ended: call reset()")
         a = float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
         if not math.isfinite(a):
             raise ValueError(f"the action must be finite, got {a}")
-        speed = float(np.clip(a, -1.0, 1.0)) * self._session.max_speed_deg_s
-        row = self._session.step(twine_speed_deg_s=speed)
+        return float(np.clip(a, -1.0, 1.0)) * self._session.max_speed_deg_s
+
+    def _after_step(self, row):
+        """``step``'s answer for the tick that gave trace row ``row``."""
         if row is None:
             # The run was already over (an error on the last read): nothing ran.
             return self._last_obs, 0.0, False, True, self._finish({})
@@ -211,6 +260,8 @@ class GripEnv(gymnasium.Env):
         return info
 
     def _finish(self, info):
+        if self.render_mode is not None:
+            self.render()
         summary = json.loads(self._session.finish())
         self._session = None
         info["summary"] = summary

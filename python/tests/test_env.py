@@ -12,7 +12,7 @@ from conftest import SHORT_LIFT
 
 def test_the_environment_passes_gymnasiums_checks():
     env = GripEnv()
-    check_env(env, skip_render_check=True)
+    check_env(env)
     env.close()
 
 
@@ -80,3 +80,38 @@ def test_a_seeded_reset_repeats_the_episode():
     again = [env.reset(seed=9)[0]] + [env.step(np.array([0.5], dtype=np.float32))[0] for _ in range(300)]
     np.testing.assert_array_equal(np.array(first), np.array(again))
     env.close()
+
+
+def test_rgb_array_renders_the_scene():
+    env = GripEnv(SHORT_LIFT, render_mode="rgb_array", render_width=160, render_height=120)
+    check_env(env)
+    env.reset(seed=1)
+    for _ in range(200):
+        env.step(np.array([0.3], dtype=np.float32))
+    frame = env.render()
+    assert frame.shape == (120, 160, 3) and frame.dtype == np.uint8
+    # A picture of something: the scene, not a blank buffer.
+    assert frame.std() > 10.0
+    env.close()
+    with pytest.raises(ValueError, match="render_mode"):
+        GripEnv(render_mode="human")
+
+
+def test_the_reward_ranks_a_grip_at_the_setpoint_above_a_hard_squeeze():
+    def episode(gain):
+        env = GripEnv(SHORT_LIFT)
+        obs, _ = env.reset(seed=2)
+        total, done = 0.0, False
+        while not done:
+            # Proportional on the setpoint (gain 1) or on three times it (a squeeze).
+            action = np.clip([0.5 * (gain * obs[3] - obs[2])], -1.0, 1.0).astype(np.float32)
+            obs, reward, terminated, truncated, info = env.step(action)
+            total += reward
+            done = terminated or truncated
+        env.close()
+        return total, info["summary"]["outcome"]
+
+    near, near_outcome = episode(1.0)
+    squeeze, squeeze_outcome = episode(3.0)
+    assert near_outcome == squeeze_outcome == "held"
+    assert near > squeeze + 0.5

@@ -1,8 +1,10 @@
 """tendril.run and run_many: the command line's runs, from Python."""
 
+import _thread
 import json
 import subprocess
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -78,6 +80,66 @@ def test_run_many_gives_the_runs_one_by_one_would_in_order():
     np.testing.assert_array_equal(many[1].trace["force_n"], alone.trace["force_n"])
     with pytest.raises(ValueError, match="threads"):
         tendril.run_many(scenarios, threads=0)
+
+
+def test_run_many_reports_progress_and_stops_when_the_callback_raises():
+    scenarios = [tendril.load(SHORT_LIFT, set={"seed": s}) for s in (1, 2, 3)]
+    seen = []
+    tendril.run_many(scenarios, threads=2, progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(1, 3), (2, 3), (3, 3)]
+
+    def give_up(done, total):
+        raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        tendril.run_many(scenarios, threads=1, progress=give_up)
+
+
+def test_ctrl_c_stops_the_run_safely_and_keeps_what_it_wrote(tmp_path):
+    # Ctrl-C half a second in (what Python's SIGINT handler does: a KeyboardInterrupt on the main
+    # thread), in a run slowed by a controller that sleeps, so that it is still going.
+    def slow(ctx):
+        time.sleep(0.002)
+        return 0.0
+
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        tendril.run(SHORT_LIFT, out=tmp_path, controller=slow)
+    assert time.monotonic() - started < 5.0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["outcome"] == "error" and "interrupted" in summary["error"]
+    lines = (tmp_path / "trace.csv").read_text().splitlines()
+    assert len(lines) > 10 and lines[-1].count(",") == lines[0].count(",")
+
+
+def test_run_many_stops_on_ctrl_c():
+    scenarios = [tendril.load(SHORT_LIFT, set={"seed": s}) for s in range(1, 9)]
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        tendril.run_many(scenarios, threads=1)
+    # Eight runs one after another take several seconds; the interrupt ends them at once.
+    assert time.monotonic() - started < 2.0
+
+
+def test_a_controller_slower_than_the_tick_is_reported_with_its_time():
+    calls = []
+
+    def sometimes_slow(ctx):
+        calls.append(1)
+        if len(calls) == 5:
+            time.sleep(0.015)
+        return 20.0 * (ctx.setpoint_n - ctx.force_n)
+
+    with pytest.warns(tendril.SlowControllerWarning, match=r"longer than the 10.00 ms control tick in 1 of"):
+        run = tendril.run(SHORT_LIFT, controller=sometimes_slow)
+    times = run.controller_times
+    assert times["calls"] == len(calls) and times["over_tick"] == 1 and times["max_ms"] >= 15.0
+    assert times["mean_ms"] < times["max_ms"]
+    assert tendril.run(SHORT_LIFT).controller_times is None
 
 
 def test_a_run_lets_other_python_threads_go_on():

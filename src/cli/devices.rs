@@ -3,6 +3,7 @@
 use tendril_config::Override;
 use tendril_drivers::RealCellConfig;
 use tendril_drivers::realtime::RealtimeOptions;
+use tendril_run::real::Devices;
 use tendril_run::scenario::PickPlaceScenario;
 
 /// Where the real (or virtual) devices are, how strict the watchdog is, how the control thread
@@ -58,29 +59,23 @@ impl DeviceArgs {
     /// The cell configuration; the interrogator period and `[hardware]` come from the scenario.
     pub fn config(&self, scenario: &PickPlaceScenario) -> anyhow::Result<RealCellConfig> {
         let dxl = self.dxl.as_deref().ok_or_else(|| anyhow::anyhow!("--hardware real needs --dxl PORT"))?;
-        let mut c = RealCellConfig::new(&self.ur, dxl, &self.interrogator);
-        c.hardware = scenario.hardware;
-        c.sensor_period_s = 1.0 / scenario.interrogator.sample_rate_hz;
-        let mut c = c.with_control_rate(scenario.control_rate_hz);
-        // The limits: at least one period of their stream, at most 10 s (a UR5e's own program
-        // watchdog stops the arm after 0.5 s without our inputs).
-        let w = &mut c.watchdog;
-        for (flag, given, limit, least_ms) in [
-            ("--sensor-stale-ms", self.sensor_stale_ms, &mut w.sensor_stale_s, c.sensor_period_s * 1e3),
-            ("--arm-stale-ms", self.arm_stale_ms, &mut w.arm_stale_s, 1e3 / tendril_drivers::ur::OUTPUT_RATE_HZ),
-            ("--motor-stale-ms", self.motor_stale_ms, &mut w.motor_stale_s, 1.0),
-        ] {
-            if let Some(ms) = given {
-                anyhow::ensure!(
-                    ms.is_finite() && (least_ms..=10_000.0).contains(&ms),
-                    "{flag} must be {least_ms}-10000 (one period of its stream to 10 s), got {ms}"
-                );
-                *limit = ms * 1e-3;
+        let devices = Devices {
+            port_base: self.port_base,
+            sensor_stale_ms: self.sensor_stale_ms,
+            arm_stale_ms: self.arm_stale_ms,
+            motor_stale_ms: self.motor_stale_ms,
+            ..Devices::new(&self.ur, dxl, &self.interrogator)
+        };
+        // The flags' names in the messages, as the user typed them.
+        devices.config(scenario).map_err(|e| {
+            let text = e.to_string();
+            let flag = text.split_once(' ').map_or(text.as_str(), |(key, _)| key);
+            match flag {
+                "sensor_stale_ms" | "arm_stale_ms" | "motor_stale_ms" => {
+                    anyhow::anyhow!("--{}", text.replacen('_', "-", 2))
+                }
+                _ => e,
             }
-        }
-        Ok(match self.port_base {
-            Some(base) => c.with_port_base(base),
-            None => c,
         })
     }
 }
@@ -88,8 +83,5 @@ impl DeviceArgs {
 /// Parses `--port-base N`: six ports N..N+5 must fit below 65536.
 pub fn port_base(text: &str) -> Result<u16, String> {
     let base: u16 = text.parse().map_err(|e| format!("{e}"))?;
-    if base == 0 || base > u16::MAX - 5 {
-        return Err(format!("must be 1-{} (ports N..N+5)", u16::MAX - 5));
-    }
-    Ok(base)
+    tendril_run::real::check_port_base(base).map_err(|_| format!("must be 1-{} (ports N..N+5)", u16::MAX - 5))
 }

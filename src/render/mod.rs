@@ -14,18 +14,13 @@
 pub mod overlay;
 pub mod video;
 
-use mujoco_rs::mujoco_c::{_mjtObjBase, mjtFrame, mjtJoint, mjtVisFlag};
-use mujoco_rs::prelude::{MjData, MjModel};
-use mujoco_rs::renderer::{MjRenderer, RendererError};
-use mujoco_rs::wrappers::mj_visualization::MjvCamera;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use tendril_render::{SceneRenderer, View};
 use tendril_run::scenario::PickPlaceScenario;
-use tendril_twin::frames::{self, FRAMES_FILE, FrameLog};
+use tendril_twin::frames::{self, FRAMES_FILE, FrameLog, Snapshot};
 use tendril_twin::physics::SceneModel;
 
-/// Largest picture side \[px\] (and so the offscreen buffer's).
-pub const MAX_SIDE: u32 = 4096;
+pub use tendril_render::MAX_SIDE;
 
 /// What to render and how.
 #[derive(Debug, Clone)]
@@ -143,39 +138,6 @@ pub fn frame_count(cell_s: f64, fps: f64, speed: f64) -> usize {
     (cell_s * fps / speed + 1e-6).floor() as usize + 1
 }
 
-/// The error when no offscreen OpenGL context can be opened.
-fn no_gl(e: &RendererError) -> anyhow::Error {
-    let cause = match e {
-        RendererError::GlutinError(g) => g.to_string(),
-        other => other.to_string(),
-    };
-    anyhow::anyhow!(
-        "cannot render: no offscreen OpenGL context through EGL ({cause}); install Mesa's EGL and \
-         OpenGL drivers (Debian/Ubuntu: libegl1 libgl1-mesa-dri) or a GPU driver with EGL"
-    )
-}
-
-/// Dresses `model`, a copy of `scene`'s, for the screen as `tendril render` and `tendril view`
-/// show it: a brighter headlight (the scene's own lights leave the arm and the hand dark) and the
-/// sensor pad in orange.
-pub(crate) fn dress_for_screen(model: &mut MjModel, scene: &SceneModel) {
-    let vis = model.vis_mut();
-    vis.headlight.ambient = [0.35, 0.35, 0.35];
-    vis.headlight.diffuse = [0.6, 0.6, 0.6];
-    for &g in scene.pad_geoms() {
-        model.geom_rgba_mut()[g] = [1.0, 0.45, 0.0, 1.0];
-    }
-}
-
-/// Where the free camera looks in `data`'s state: the object's grip, or the hand when the scene
-/// has no object.
-pub(crate) fn camera_target(scene: &SceneModel, data: &MjData<Arc<MjModel>>) -> [f64; 3] {
-    match scene.object_grip_geom() {
-        Some(g) => data.geom_xpos()[g],
-        None => data.xpos()[scene.hand_body()],
-    }
-}
-
 /// Renders the run in `run_dir` (its `frames.bin`, `scenario.toml` and, for the panel,
 /// `trace.csv`) to `opts.out`.
 pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<RenderStats> {
@@ -190,18 +152,25 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
         anyhow::bail!("{}: no such file: the run directory must hold the run's scenario.toml", scenario_path.display());
     }
     let scenario: PickPlaceScenario = tendril_config::load(&scenario_path, &[])?;
-    let scene = SceneModel::build(&scenario.scene_spec())?;
+    let scene = std::sync::Arc::new(SceneModel::build(&scenario.scene_spec())?);
     let trace = if opts.panel { Some(tendril_plot::trace::read(run_dir)?) } else { None };
-
-    // The run's model with what only the picture needs changed: the offscreen buffer's size and
-    // the sensor pad's colour.
-    let mut model: MjModel = (**scene.model()).clone();
-    let sizes = frames::StateSizes {
-        nq: model.ffi().nq as usize,
-        nv: model.ffi().nv as usize,
-        nu: model.ffi().nu as usize,
-        na: model.ffi().na as usize,
+    let view = View {
+        width: opts.width,
+        height: opts.height,
+        camera: opts.camera.clone(),
+        distance_m: opts.distance_m,
+        azimuth_deg: opts.azimuth_deg,
+        elevation_deg: opts.elevation_deg,
+        // Contact forces as MuJoCo draws them. A rapier run's states are drawn through the same
+        // model, but MuJoCo's contact solve at rapier's penetrations is not rapier's force: left out there.
+        contact_forces: scenario.scene_spec().physics.backend == tendril_twin::physics::Backend::Mujoco,
     };
+    let mut renderer = SceneRenderer::new(&scene, &view).map_err(|e| match &opts.camera {
+        Some(_) if e.to_string().starts_with("camera ") => anyhow::anyhow!("--{e}"),
+        _ => e,
+    })?;
+    let [nq, nv, nu, na] = renderer.state_sizes();
+    let sizes = frames::StateSizes { nq, nv, nu, na };
     if sizes != log.sizes {
         anyhow::bail!(
             "{}: recorded for a model with {:?}, but {} builds one with {:?}: the scenario or the models \
@@ -212,56 +181,6 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
             sizes
         );
     }
-    {
-        let vis = model.vis_mut();
-        vis.global.offwidth = vis.global.offwidth.max(opts.width as i32);
-        vis.global.offheight = vis.global.offheight.max(opts.height as i32);
-        // Contact force arrows: 2 cm per newton (the grip is a few newtons), thinner than default.
-        vis.map.force = 0.02;
-        vis.scale.forcewidth = 0.02;
-    }
-    dress_for_screen(&mut model, &scene);
-    let model = Arc::new(model);
-    let mut data = MjData::new(model.clone());
-
-    let camera = match &opts.camera {
-        Some(name) => {
-            let id = model.name_to_id(_mjtObjBase::mjOBJ_CAMERA, name).ok_or_else(|| {
-                let names: Vec<&str> = (0..model.ffi().ncam as usize)
-                    .filter_map(|c| model.id_to_name(_mjtObjBase::mjOBJ_CAMERA, c))
-                    .collect();
-                anyhow::anyhow!(
-                    "--camera {name}: the scene has no such camera (it has: {}); leave --camera out for \
-                     the free camera on the object",
-                    if names.is_empty() { "none".to_string() } else { names.join(", ") }
-                )
-            })?;
-            MjvCamera::new_fixed(id)
-        }
-        None => {
-            let mut cam = MjvCamera::new_free(&model);
-            set_state(&mut data, &log, 0, &model);
-            data.forward();
-            cam.lookat = camera_target(&scene, &data);
-            cam.distance = opts.distance_m;
-            cam.azimuth = opts.azimuth_deg;
-            cam.elevation = opts.elevation_deg;
-            cam
-        }
-    };
-    let mut options = mujoco_rs::wrappers::mj_visualization::MjvOption::default();
-    // Contact forces as MuJoCo draws them. A rapier run's states are drawn through the same model,
-    // but MuJoCo's contact solve at rapier's penetrations is not rapier's force: left out there.
-    let mujoco = scenario.scene_spec().physics.backend == tendril_twin::physics::Backend::Mujoco;
-    options.flags[mjtVisFlag::mjVIS_CONTACTFORCE as usize] = u8::from(mujoco);
-    options.frame = mjtFrame::mjFRAME_NONE as i32;
-    let mut renderer = MjRenderer::builder()
-        .width(opts.width)
-        .height(opts.height)
-        .camera(camera)
-        .opts(options)
-        .build(&model)
-        .map_err(|e| no_gl(&e))?;
 
     let cell_s = *log.times.last().unwrap_or(&0.0);
     let n = frame_count(cell_s, opts.fps, opts.speed);
@@ -276,12 +195,8 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
     let still = opts.still_s.map(|s| ((s.clamp(0.0, cell_s) * opts.fps / opts.speed).round() as usize).min(n - 1));
     for k in 0..n {
         let t = (k as f64 * opts.speed / opts.fps).min(cell_s);
-        let i = nearest(&log.times, t);
-        set_state(&mut data, &log, i, &model);
-        data.forward();
-        renderer.sync_data(&mut data).map_err(|e| anyhow::anyhow!("cannot render frame {k}: {e}"))?;
-        renderer.render().map_err(|e| anyhow::anyhow!("cannot render frame {k}: {e}"))?;
-        let rgb = renderer.rgb_flat().ok_or_else(|| anyhow::anyhow!("the renderer gave no RGB image"))?;
+        let state = frame_state(&log, nearest(&log.times, t));
+        let rgb = renderer.render(&state).map_err(|e| e.context(format!("frame {k}")))?;
         picture[..rgb.len()].copy_from_slice(rgb);
         if let Some(p) = panel.as_mut() {
             p.draw(t, &mut picture[rgb.len()..])?;
@@ -329,38 +244,14 @@ fn nearest(times: &[f64], t: f64) -> usize {
     }
 }
 
-/// Sets frame `i`'s state into `data`, quaternions renormalised (f32 rounding).
-fn set_state(data: &mut MjData<Arc<MjModel>>, log: &FrameLog, i: usize, model: &MjModel) {
-    let Some(v) = log.frame(i) else { return };
+/// Frame `i`'s state (`log` is not empty and `i` in range: [`nearest`]'s answer).
+fn frame_state(log: &FrameLog, i: usize) -> Snapshot {
+    let v: Vec<f64> = log.frame(i).unwrap_or_default().iter().map(|&x| f64::from(x)).collect();
     let s = log.sizes;
-    let (q, rest) = v.split_at(s.nq);
-    let (qv, rest) = rest.split_at(s.nv);
-    let (u, a) = rest.split_at(s.nu);
-    for (dst, src) in data.qpos_mut().iter_mut().zip(q) {
-        *dst = f64::from(*src);
-    }
-    for j in 0..model.ffi().njnt as usize {
-        let adr = model.jnt_qposadr()[j] as usize;
-        let quat = match model.jnt_type()[j] {
-            mjtJoint::mjJNT_FREE => adr + 3..adr + 7,
-            mjtJoint::mjJNT_BALL => adr..adr + 4,
-            _ => continue,
-        };
-        let qp = &mut data.qpos_mut()[quat];
-        let norm = qp.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if norm > 0.0 {
-            qp.iter_mut().for_each(|x| *x /= norm);
-        }
-    }
-    for (dst, src) in data.qvel_mut().iter_mut().zip(qv) {
-        *dst = f64::from(*src);
-    }
-    for (dst, src) in data.ctrl_mut().iter_mut().zip(u) {
-        *dst = f64::from(*src);
-    }
-    for (dst, src) in data.act_mut().iter_mut().zip(a) {
-        *dst = f64::from(*src);
-    }
+    let (qpos, rest) = v.split_at(s.nq);
+    let (qvel, rest) = rest.split_at(s.nv);
+    let (ctrl, act) = rest.split_at(s.nu);
+    Snapshot { qpos: qpos.to_vec(), qvel: qvel.to_vec(), ctrl: ctrl.to_vec(), act: act.to_vec() }
 }
 
 #[cfg(test)]

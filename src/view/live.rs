@@ -333,13 +333,13 @@ fn viewer_model(sim: &SimCell) -> mujoco_rs::prelude::MjModel {
     let shared = sim.model();
     let start = tendril_twin::physics::Scene::new(shared.clone());
     let mut model = (**shared.model()).clone();
-    model.stat_mut().center = crate::render::camera_target(shared, start.data());
+    model.stat_mut().center = tendril_render::camera_target(shared, start.data());
     model.stat_mut().extent = CAMERA_DISTANCE_M / 1.5;
     let render = crate::render::RenderOptions::default();
     let vis = model.vis_mut();
     vis.global.azimuth = render.azimuth_deg as f32;
     vis.global.elevation = render.elevation_deg as f32;
-    crate::render::dress_for_screen(&mut model, shared);
+    tendril_render::dress_for_screen(&mut model, shared);
     model
 }
 

@@ -25,8 +25,8 @@ pub const LAYERS: &[&[&str]] = &[
     &["tendril-cell"],
     // Above the seam: the control side, the twin, the real devices' drivers.
     &["tendril-control", "tendril-twin", "tendril-drivers"],
-    // One run on any cell.
-    &["tendril-run"],
+    // One run on any cell; pictures of the twin's scene.
+    &["tendril-run", "tendril-render"],
     // The virtual devices, the charts.
     &["tendril-serve", "tendril-plot"],
     // The two front ends: the command line (and what only it does), the Python package.

@@ -9,6 +9,7 @@ use crate::context::ControlContext;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Instant;
 use tendril_control::controller::{self as rust, ForceController};
 
 /// The first error of a Python controller, with its traceback as text.
@@ -39,6 +40,57 @@ impl Failure {
     }
 }
 
+/// How long the controller's `update` calls took, measured around each call (the GIL's
+/// acquisition included: on the real cell the tick waits for both).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CallTimes {
+    /// `update` calls made.
+    pub calls: u64,
+    /// Their total time \[s\].
+    pub total_s: f64,
+    /// The longest \[s\].
+    pub max_s: f64,
+    /// Calls that took longer than the control tick.
+    pub over_tick: u64,
+    /// The control tick \[s\] (of the last call).
+    pub tick_s: f64,
+}
+
+impl CallTimes {
+    fn add(&mut self, took_s: f64, tick_s: f64) {
+        self.calls += 1;
+        self.total_s += took_s;
+        self.max_s = self.max_s.max(took_s);
+        self.over_tick += u64::from(took_s > tick_s);
+        self.tick_s = tick_s;
+    }
+
+    /// Why the controller is too slow for a real cell, if a call took longer than the tick.
+    pub fn too_slow(&self) -> Option<String> {
+        (self.over_tick > 0).then(|| {
+            format!(
+                "update(ctx) took {:.2} ms, longer than the {:.2} ms control tick ({} of {} calls): the \
+                 commands would be late",
+                self.max_s * 1e3,
+                self.tick_s * 1e3,
+                self.over_tick,
+                self.calls
+            )
+        })
+    }
+}
+
+/// The call times, shared between the controller and whoever reports them.
+#[derive(Clone, Default)]
+pub struct Timing(Arc<Mutex<CallTimes>>);
+
+impl Timing {
+    /// The times so far.
+    pub fn get(&self) -> CallTimes {
+        *self.0.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
 /// `err` as Python prints it: the traceback, then `Type: message`.
 fn describe(py: Python<'_>, err: &PyErr) -> String {
     let traceback = err.traceback(py).and_then(|t| t.format().ok()).unwrap_or_default();
@@ -62,6 +114,7 @@ pub struct PyController {
     has_reset: bool,
     max_speed_deg_s: f64,
     failure: Failure,
+    timing: Timing,
 }
 
 impl std::fmt::Debug for PyController {
@@ -100,7 +153,13 @@ impl PyController {
             has_reset: obj.hasattr("reset")?,
             max_speed_deg_s,
             failure: Failure::default(),
+            timing: Timing::default(),
         })
+    }
+
+    /// Where the controller's call times are kept.
+    pub fn timing(&self) -> Timing {
+        self.timing.clone()
     }
 
     /// Where the controller's first error is kept.
@@ -133,12 +192,15 @@ impl ForceController for PyController {
         if self.failure.is_set() {
             return 0.0;
         }
-        Python::attach(|py| {
+        let started = Instant::now();
+        let speed = Python::attach(|py| {
             self.speed(py, ctx).unwrap_or_else(|e| {
                 self.failure.set(py, e);
                 0.0
             })
-        })
+        });
+        self.timing.0.lock().unwrap_or_else(PoisonError::into_inner).add(started.elapsed().as_secs_f64(), ctx.dt_s);
+        speed
     }
 
     fn reset(&mut self) {

@@ -7,6 +7,7 @@ mod controller;
 mod errors;
 mod models;
 mod overrides;
+mod render;
 mod run;
 mod scenario;
 mod session;
@@ -23,6 +24,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<context::ControlContext>()?;
     m.add_class::<models::ModelCache>()?;
     m.add_class::<session::Session>()?;
+    m.add_class::<render::Renderer>()?;
+    m.add_function(wrap_pyfunction!(session::step_all, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(run::run_many, m)?)?;

@@ -8,12 +8,16 @@ use crate::scenario::Scenario;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::{Mutex, PoisonError};
+use rayon::prelude::*;
+use std::sync::{Arc, Mutex, PoisonError};
 use tendril_cell::{Cell, Phase};
 use tendril_run::clock::RunClock;
 use tendril_run::execute::{summarize, summary_json};
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_run::session::{Action, Observation};
+use tendril_run::trace::TraceRow;
+use tendril_twin::frames::Snapshot;
+use tendril_twin::physics::SceneModel;
 use tendril_twin::sim::SimCell;
 
 /// The task's phases in order: an observation's `phase_index` is the position in this list.
@@ -43,6 +47,7 @@ struct State {
 #[pyclass(frozen, module = "tendril._native")]
 pub struct Session {
     scenario: PickPlaceScenario,
+    scene: Arc<SceneModel>,
     max_speed_deg_s: f64,
     state: Mutex<State>,
 }
@@ -58,16 +63,18 @@ impl Session {
         let models = models.unwrap_or(&own);
         let controller = scenario.controller.build();
         let max_speed_deg_s = controller.max_speed_deg_s();
-        let state = py.detach(|| -> anyhow::Result<State> {
+        let state = py.detach(|| -> anyhow::Result<(State, Arc<SceneModel>)> {
             let started = RunClock::start();
             let _ = tendril_twin::mujoco_log::take_warnings();
-            let cell = scenario.sim_cell(models.inner.get(&scenario.scene_spec())?);
+            let scene = models.inner.get(&scenario.scene_spec())?;
+            let cell = scenario.sim_cell(scene.clone());
             let backend = cell.backend().to_string();
             let plan = scenario.control_plan();
             let session = tendril_run::session::Session::start(cell, &plan, controller, None);
-            Ok(State { session: Some(session), backend, started, summary: None })
+            Ok((State { session: Some(session), backend, started, summary: None }, scene))
         });
-        Ok(Session { scenario, max_speed_deg_s, state: Mutex::new(state.map_err(run_error)?) })
+        let (state, scene) = state.map_err(run_error)?;
+        Ok(Session { scenario, scene, max_speed_deg_s, state: Mutex::new(state) })
     }
 
     /// The largest twine speed the controller commands [°/s]: a `twine_speed_deg_s` action is
@@ -111,16 +118,8 @@ impl Session {
         twine_speed_deg_s: Option<f64>,
         setpoint_n: Option<f64>,
     ) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let action = match (twine_speed_deg_s, setpoint_n) {
-            (None, None) => Action::Controller,
-            (Some(v), None) if v.is_finite() => Action::TwineSpeed(v),
-            (None, Some(v)) if v.is_finite() => Action::Setpoint(v),
-            (Some(_), Some(_)) => {
-                return Err(PyValueError::new_err("step: give twine_speed_deg_s or setpoint_n, not both"));
-            }
-            _ => return Err(PyValueError::new_err("step: the action must be a finite number")),
-        };
-        let row = py.detach(|| self.lock().session.as_mut().and_then(|s| s.step(action)));
+        let action = action(twine_speed_deg_s, setpoint_n)?;
+        let row = py.detach(|| self.step_once(action));
         row.map(|r| row_dict(py, &r)).transpose()
     }
 
@@ -146,9 +145,63 @@ impl Session {
 }
 
 impl Session {
+    /// The compiled scene model the session runs.
+    pub fn scene(&self) -> Arc<SceneModel> {
+        self.scene.clone()
+    }
+
+    /// The scene's current state (`None` once the run is over or when the physics keeps none).
+    pub fn snapshot(&self) -> Option<Snapshot> {
+        self.lock().session.as_ref().and_then(|s| s.cell().snapshot())
+    }
+
+    /// One tick (without the GIL: the caller detaches).
+    fn step_once(&self, action: Action) -> Option<TraceRow> {
+        self.lock().session.as_mut().and_then(|s| s.step(action))
+    }
+
     fn lock(&self) -> std::sync::MutexGuard<'_, State> {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
+}
+
+/// The action of a `step(twine_speed_deg_s, setpoint_n)` call.
+fn action(twine_speed_deg_s: Option<f64>, setpoint_n: Option<f64>) -> PyResult<Action> {
+    match (twine_speed_deg_s, setpoint_n) {
+        (None, None) => Ok(Action::Controller),
+        (Some(v), None) if v.is_finite() => Ok(Action::TwineSpeed(v)),
+        (None, Some(v)) if v.is_finite() => Ok(Action::Setpoint(v)),
+        (Some(_), Some(_)) => Err(PyValueError::new_err("step: give twine_speed_deg_s or setpoint_n, not both")),
+        _ => Err(PyValueError::new_err("step: the action must be a finite number")),
+    }
+}
+
+/// Steps every session in `sessions` one tick, in parallel on the worker threads (one per core),
+/// without the GIL: `twine_speeds_deg_s[i]` is session i's `twine_speed_deg_s` (`None`: its
+/// controller acts). Returns each tick's trace row as `step` does (`None` for a session whose
+/// run is over). What a vector environment steps its twins with.
+#[pyfunction]
+pub fn step_all<'py>(
+    py: Python<'py>,
+    sessions: Vec<Bound<'py, Session>>,
+    twine_speeds_deg_s: Vec<Option<f64>>,
+) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
+    if sessions.len() != twine_speeds_deg_s.len() {
+        return Err(PyValueError::new_err(format!(
+            "step_all: {} sessions but {} actions",
+            sessions.len(),
+            twine_speeds_deg_s.len()
+        )));
+    }
+    let actions = twine_speeds_deg_s.into_iter().map(|v| action(v, None)).collect::<PyResult<Vec<_>>>()?;
+    for (i, pair) in sessions.iter().enumerate() {
+        if sessions[..i].iter().any(|earlier| earlier.is(pair)) {
+            return Err(PyValueError::new_err(format!("step_all: session {i} is given twice")));
+        }
+    }
+    let refs: Vec<&Session> = sessions.iter().map(|s| s.get()).collect();
+    let rows: Vec<Option<TraceRow>> = py.detach(|| refs.par_iter().zip(actions).map(|(s, a)| s.step_once(a)).collect());
+    rows.iter().map(|r| r.as_ref().map(|r| row_dict(py, r)).transpose()).collect()
 }
 
 /// An observation as a dict (see [`Session::observation`]).

@@ -119,6 +119,12 @@ impl SimCell {
         &self.model
     }
 
+    /// The scene's current state in MuJoCo's layout (what `frames.bin` records and a
+    /// renderer draws); `None` before configuration or when the backend keeps no such state.
+    pub fn snapshot(&self) -> Option<crate::frames::Snapshot> {
+        self.scene.as_ref()?.snapshot()
+    }
+
     /// The run's MuJoCo data (for `tendril view`'s viewer to show and perturb), once configured
     /// and when the backend is MuJoCo.
     pub fn mujoco_data_mut(&mut self) -> Option<&mut mujoco_rs::prelude::MjData<Arc<mujoco_rs::prelude::MjModel>>> {
