@@ -77,6 +77,8 @@ pub struct SimCell {
     /// Whether [`Cell::wait_until`] samples the sensor up to the time waited for rather than the
     /// physics' time ([`SimCell::sample_every_wait`]).
     sample_to_wait_time: bool,
+    /// Whether the physics counts contacts per geom pair ([`SimCell::count_contacts`]).
+    count_contacts: bool,
 }
 
 impl SimCell {
@@ -170,6 +172,7 @@ impl SimCell {
             pushing: false,
             frames: None,
             sample_to_wait_time: false,
+            count_contacts: false,
         }
     }
 
@@ -194,6 +197,21 @@ impl SimCell {
     /// Reading the state changes nothing in the run.
     pub fn record_frames(&mut self, fps: f64) {
         self.frames = Some(crate::frames::FrameRecorder::new(fps));
+    }
+
+    /// Counts the contacts of each geom pair at every physics step of the run (from configuration
+    /// on), for [`SimCell::contact_census`]. Counting changes nothing in the run.
+    pub fn count_contacts(&mut self) {
+        self.count_contacts = true;
+        if let Some(scene) = self.scene.as_mut() {
+            scene.count_contacts();
+        }
+    }
+
+    /// The contacts counted so far, if [`SimCell::count_contacts`] was asked for and the backend
+    /// counts them (MuJoCo).
+    pub fn contact_census(&self) -> Option<crate::physics::ContactCensus> {
+        self.scene.as_ref()?.contact_census()
     }
 
     /// The frames recorded so far, if [`SimCell::record_frames`] was asked for and the backend has
@@ -253,7 +271,11 @@ impl Cell for SimCell {
 
     fn configure(&mut self) -> Result<(), CellError> {
         require_state(self.lifecycle, Lifecycle::Unconfigured, "configure")?;
-        self.scene = Some(self.model.start().map_err(Self::physics_error)?);
+        let mut scene = self.model.start().map_err(Self::physics_error)?;
+        if self.count_contacts {
+            scene.count_contacts();
+        }
+        self.scene = Some(scene);
         self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
         self.wrist = WristSensor::new(&self.wrist_config, self.seed);
         self.next_sample_s = 0.0;

@@ -71,7 +71,9 @@ fn body_of(text: &str) -> &str {
 }
 
 /// The `<compiler>`, `<option>` and contact `<default>` every scene (and validation scene) shares.
-/// Energy is computed for the runaway check; constraint islands are off (the cell is one island, and
+/// Energy is enabled for the runaway check of a scene loaded elsewhere (a run's compiled model turns
+/// MuJoCo's per-step energies off and computes the kinetic energy itself: `SceneModel::build`);
+/// constraint islands are off (the cell is one island, and
 /// finding islands cost ~20 % of a step, measured with `perf stat` on `tendril physics-check`).
 pub fn header(p: &PhysicsConfig) -> String {
     let integrator = match p.integrator {

@@ -56,6 +56,16 @@ pub trait Physics: Send {
         None
     }
 
+    /// Counts, from the next step on, the contacts of each geom pair ([`super::ContactCensus`]);
+    /// a backend without MuJoCo's contacts counts nothing.
+    fn count_contacts(&mut self) {}
+
+    /// The contacts counted so far, if [`Physics::count_contacts`] was asked for and the backend
+    /// counts them.
+    fn contact_census(&self) -> Option<super::ContactCensus> {
+        None
+    }
+
     /// Steps for `seconds` of simulated time (rounded to whole steps).
     fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
         let n = (seconds / self.timestep()).round() as usize;

@@ -9,11 +9,14 @@
 //!   model and its run ([`rapier::RapierScene`]).
 //! - [`drive`]: motor speed limits, the kinematic arm's interpolation and the grip-in-hand
 //!   readout, shared by both backends.
+//! - [`guide`]: the guide's walls left out of the collision search while they cannot touch the
+//!   strip; [`census`]: contacts per geom pair over a run (what the collision search finds).
 //! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
 //! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
 //! - `spec.rs`: what a scene holds ([`SceneSpec`]); `engine.rs`: the [`Physics`] trait; `start.rs`: a run
 //!   on a model ([`SceneModel::start`]).
 
+pub mod census;
 pub mod check;
 pub mod compose;
 pub mod config;
@@ -21,6 +24,7 @@ pub mod drive;
 mod engine;
 mod error;
 pub mod export;
+pub mod guide;
 pub mod object;
 pub mod rapier;
 pub mod scene;
@@ -30,6 +34,7 @@ pub mod strip;
 pub mod template;
 pub mod validation;
 
+pub use census::{ContactCensus, PairTally};
 pub use compose::Placement;
 pub use config::{
     ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig, Solver,

@@ -1,10 +1,12 @@
 //! One simulation run of the cell: a compiled, shareable [`SceneModel`] and per-run [`Scene`] state.
 
+use super::census::ContactCensus;
 use super::compose::{self, Placement};
 use super::config::{ArmMode, Backend};
 use super::drive::{Drive, grip_in_hand};
+use super::guide::GuidePruning;
 use super::{Divergence, Physics, PhysicsError, SceneSpec};
-use mujoco_rs::mujoco_c::{_mjtObjBase, mjtWarning};
+use mujoco_rs::mujoco_c::{_mjtObjBase, mjtEnableBit, mjtState, mjtWarning};
 use mujoco_rs::prelude::{MjData, MjModel};
 use nalgebra::{Isometry3, Vector3};
 use std::sync::Arc;
@@ -18,13 +20,16 @@ pub(crate) fn yaw_quaternion(yaw_deg: f64) -> [f64; 4] {
 
 /// A compiled scene model and the element ids the readout needs. Build it once and share it (it is
 /// `Send + Sync`) between many [`Scene`]s, for example across threads.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct SceneModel {
     model: Arc<MjModel>,
     spec: SceneSpec,
     placement: Placement,
     xml: String,
     ids: Ids,
+    /// The model without the guide walls' contacts, stepped while they cannot touch the strip
+    /// (`None`: the walls stay in throughout).
+    guide_pruning: Option<Arc<GuidePruning>>,
 }
 
 /// Ids of the elements the readout and the backends need (MuJoCo's numbering, which the rapier
@@ -109,13 +114,20 @@ impl SceneModel {
                 MjData::new(&mut model).set_const();
             }
         }
+        // MuJoCo's energy flag makes every step compute the potential and the kinetic energy; the
+        // runaway check reads only the kinetic one, which `Scene::check` computes itself (issue 39,
+        // lever 6: the potential energy was 0.3 % of a run's instructions, read by nothing). The
+        // energies feed nothing in the dynamics, so the steps are the same.
+        model.opt_mut().enableflags &= !(mjtEnableBit::mjENBL_ENERGY as i32);
         if spec.physics.arm_mode == ArmMode::Kinematic {
             // Prescribed motion: the arm must not give way to contact forces within a step.
             for d in ids.arm_dof {
                 model.dof_armature_mut()[d] = KINEMATIC_ARM_ARMATURE;
             }
         }
-        let shared = Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids });
+        let guide_pruning = GuidePruning::new(&model).map(Arc::new);
+        let shared =
+            Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids, guide_pruning });
         if spec.physics.backend == Backend::Rapier {
             // Translate once now, so an element rapier cannot take is an error before any run starts.
             super::rapier::RapierScene::new(shared.clone())?;
@@ -206,6 +218,18 @@ impl SceneModel {
     /// The compiled MuJoCo model.
     pub fn model(&self) -> &Arc<MjModel> {
         &self.model
+    }
+
+    /// The same scene with the guide's walls kept in the collision search throughout: the
+    /// reference the pruned runs are compared with (tests/guide_pruning.rs).
+    pub fn without_guide_pruning(&self) -> Arc<SceneModel> {
+        Arc::new(SceneModel { guide_pruning: None, ..self.clone() })
+    }
+
+    /// Whether runs on this model leave the guide's walls out of the collision search while they
+    /// cannot touch the strip ([`GuidePruning`]).
+    pub fn prunes_guide(&self) -> bool {
+        self.guide_pruning.is_some()
     }
 
     /// The spec it was built from.
@@ -304,6 +328,14 @@ pub struct Scene {
     warnings_seen: [i32; 8],
     /// The hand subtree's centre-of-mass Jacobian (3 x nv, row-major), reused every step.
     payload_jacobian: Vec<f64>,
+    /// Whether `data` runs on the model without the guide walls' contacts.
+    walls_pruned: bool,
+    /// The data of the other model (with or without the walls' contacts), kept for the next switch.
+    spare_data: Option<MjData<Arc<MjModel>>>,
+    /// The integration state at the start of a step on the pruned model, reused every step.
+    step_start: Vec<f64>,
+    /// Contacts per geom pair, when asked for ([`Physics::count_contacts`]).
+    census: Option<ContactCensus>,
 }
 
 /// Armature of the arm joints in the kinematic mode [kg m^2]: large enough that a few newtons of
@@ -343,7 +375,17 @@ impl Scene {
         data.forward();
         let drive = Drive::new(&shared.spec.physics, &shared.spec.finger, q0);
         let payload_jacobian = vec![0.0; 3 * shared.model.ffi().nv as usize];
-        Scene { shared, data, drive, warnings_seen: [0; 8], payload_jacobian }
+        Scene {
+            shared,
+            data,
+            drive,
+            warnings_seen: [0; 8],
+            payload_jacobian,
+            walls_pruned: false,
+            spare_data: None,
+            step_start: Vec::new(),
+            census: None,
+        }
     }
 
     /// The shared model.
@@ -371,6 +413,63 @@ impl Scene {
         for d in ids.arm_dof {
             let along_gravity: f64 = (0..3).map(|i| self.payload_jacobian[i * nv + d] * gravity[i]).sum();
             self.data.qfrc_applied_mut()[d] = -mass * along_gravity;
+        }
+    }
+
+    /// Moves the run onto the model with (`pruned` false) or without the guide walls' contacts,
+    /// carrying over everything a step starts from (MuJoCo's integration state: time, positions,
+    /// velocities, activations, the solver's warm start, controls, applied forces), or the
+    /// integration state `state` when given: the next step then computes what it would have on
+    /// the other model, but for the walls' contacts. The data of the model left is kept for the
+    /// next switch.
+    fn switch_guide(&mut self, pruned: bool, state: Option<&[f64]>) {
+        let model = match (&self.shared.guide_pruning, pruned) {
+            (Some(p), true) => p.model().clone(),
+            _ => self.shared.model.clone(),
+        };
+        let mut data = self.spare_data.take().unwrap_or_else(|| MjData::new(model));
+        let integration = mjtState::mjSTATE_INTEGRATION as u32;
+        match state {
+            Some(state) => data.set_state(state, integration),
+            None => data.copy_state_from_data(&self.data, integration),
+        }
+        .expect("the pruned model has the same layout");
+        self.spare_data = Some(std::mem::replace(&mut self.data, data));
+        // Warnings are counted per data.
+        self.warnings_seen = [0; 8];
+        for (k, (w, _)) in FATAL_WARNINGS.iter().enumerate() {
+            self.warnings_seen[k] = self.data.warning()[*w as usize].number;
+        }
+        self.walls_pruned = pruned;
+    }
+
+    /// Takes one MuJoCo step, on the model without the guide walls' contacts when they cannot
+    /// touch anything ([`GuidePruning`]): a step taken there is checked with the positions its
+    /// collision search used, and taken again on the full model, from the state it started at,
+    /// if the walls might have touched. The contacts, and so the trajectory, are the full model's.
+    fn mj_step(&mut self) {
+        let Some(pruning) = self.shared.guide_pruning.clone() else {
+            self.data.step();
+            return;
+        };
+        // Positions of the last step's start: a guess, checked below.
+        if !self.walls_pruned && pruning.walls_idle(&self.data, pruning.first_link_clear(self.data.qpos())) {
+            self.switch_guide(true, None);
+        }
+        if !self.walls_pruned {
+            self.data.step();
+            return;
+        }
+        let integration = mjtState::mjSTATE_INTEGRATION as u32;
+        self.step_start.resize(self.data.model().state_size(integration), 0.0);
+        self.data.read_state_into(integration, &mut self.step_start);
+        let first_link_clear = pruning.first_link_clear(self.data.qpos());
+        self.data.step();
+        if !pruning.walls_idle(&self.data, first_link_clear) {
+            let start = std::mem::take(&mut self.step_start);
+            self.switch_guide(false, Some(&start));
+            self.step_start = start;
+            self.data.step();
         }
     }
 
@@ -403,7 +502,9 @@ impl Scene {
                 });
             }
         }
-        // Kinetic energy of what is simulated: the kinematic arm's armature term is prescribed motion.
+        // Kinetic energy of what is simulated (½ qvel' M qvel, M from the step's start), the
+        // kinematic arm's armature term taken out: that is prescribed motion.
+        self.data.energy_vel();
         let mut kinetic = self.data.energy()[1];
         if self.shared.ids.arm_act.is_none() {
             for d in self.shared.ids.arm_dof {
@@ -550,8 +651,21 @@ impl Physics for Scene {
                 self.compensate_payload();
             }
         }
-        self.data.step();
+        // After the inputs are set (the payload compensation reads this data's last kinematics),
+        // so that a switch of model carries them over with the state.
+        self.mj_step();
+        if let Some(census) = self.census.as_mut() {
+            census.record(&self.data, t0 + dt);
+        }
         self.check(t0 + dt)
+    }
+
+    fn count_contacts(&mut self) {
+        self.census.get_or_insert_with(ContactCensus::default);
+    }
+
+    fn contact_census(&self) -> Option<ContactCensus> {
+        self.census.clone()
     }
 
     fn set_object_force(&mut self, force_n: [f64; 3]) -> Result<(), PhysicsError> {
