@@ -38,7 +38,7 @@ from grip_task import DISTURBANCE_SETS, OBJECTS, GripTask  # noqa: E402
 
 #: PPO's settings (Stable-Baselines3's names; the rest are its defaults). Why these: the task
 #: runs at 100 Hz and a grip error matters over a second or two, so the discount looks 2 s ahead
-#: (1 / (1 - 0.995) ticks); 2048 ticks on each of 4 environments make an update of 8192 ticks,
+#: (1 / (1 - 0.995) ticks); 2048 steps on each of 4 environments make an update of 8192,
 #: about two whole tasks; the policy starts with a small spread (exp(-1.5) = 0.22 of the speed
 #: limit) because a twine speed is integrated into the tendon's position, and a wide random walk
 #: of it squeezes or drops the object before anything is learnt.
