@@ -2,6 +2,7 @@
 
 import _thread
 import json
+import signal
 import subprocess
 import threading
 import time
@@ -95,7 +96,17 @@ def test_run_many_reports_progress_and_stops_when_the_callback_raises():
         tendril.run_many(scenarios, threads=1, progress=give_up)
 
 
-def test_ctrl_c_stops_the_run_safely_and_keeps_what_it_wrote(tmp_path):
+@pytest.fixture
+def ctrl_c_raises():
+    """Python's own Ctrl-C handler (KeyboardInterrupt) for the test. A process started in the
+    background by a shell without job control inherits SIGINT ignored, and then Python neither
+    installs the handler nor turns `_thread.interrupt_main()` into a KeyboardInterrupt."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_stops_the_run_safely_and_keeps_what_it_wrote(tmp_path, ctrl_c_raises):
     # Ctrl-C half a second in (what Python's SIGINT handler does: a KeyboardInterrupt on the main
     # thread), in a run slowed by a controller that sleeps, so that it is still going.
     def slow(ctx):
@@ -114,7 +125,7 @@ def test_ctrl_c_stops_the_run_safely_and_keeps_what_it_wrote(tmp_path):
     assert len(lines) > 10 and lines[-1].count(",") == lines[0].count(",")
 
 
-def test_run_many_stops_on_ctrl_c():
+def test_run_many_stops_on_ctrl_c(ctrl_c_raises):
     scenarios = [tendril.load(SHORT_LIFT, set={"seed": s}) for s in range(1, 9)]
     timer = threading.Timer(0.3, _thread.interrupt_main)
     timer.start()
