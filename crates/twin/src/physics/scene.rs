@@ -452,8 +452,10 @@ impl Scene {
             self.data.step();
             return;
         };
+        // The step's positions: a switch of model carries them over, so this holds on either.
+        let first_link_clear = pruning.first_link_clear(self.data.qpos());
         // Positions of the last step's start: a guess, checked below.
-        if !self.walls_pruned && pruning.walls_idle(&self.data, pruning.first_link_clear(self.data.qpos())) {
+        if !self.walls_pruned && pruning.walls_idle(&self.data, first_link_clear) {
             self.switch_guide(true, None);
         }
         if !self.walls_pruned {
@@ -463,7 +465,6 @@ impl Scene {
         let integration = mjtState::mjSTATE_INTEGRATION as u32;
         self.step_start.resize(self.data.model().state_size(integration), 0.0);
         self.data.read_state_into(integration, &mut self.step_start);
-        let first_link_clear = pruning.first_link_clear(self.data.qpos());
         self.data.step();
         if !pruning.walls_idle(&self.data, first_link_clear) {
             let start = std::mem::take(&mut self.step_start);
