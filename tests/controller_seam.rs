@@ -78,6 +78,7 @@ impl Cell for ToyCell {
             growth_motor_rad: self.growth_rad,
             twine_motor_rad: self.twine_rad,
             wavelengths: self.bad.get(&tick).copied().unwrap_or(good),
+            array: Default::default(),
             tool_load_n: None,
         })
     }
@@ -105,6 +106,7 @@ fn plan(feedback: bool) -> ControlPlan {
         gripper: GripperConfig::default(),
         slip: SlipConfig::default(),
         object_weight_n: None,
+        array_control: Default::default(),
     }
 }
 

@@ -192,6 +192,7 @@ fn writers_on_a_full_device_report_the_error() {
         slip_speed_m_s: 0.0,
         grip_force_n: 0.0,
         tool_load_n: f64::NAN,
+        array: Default::default(),
     };
     let wrote = (0..100).all(|_| trace.write(&r).is_ok());
     assert!(!wrote || trace.flush().is_err());

@@ -2,6 +2,7 @@
 
 use crate::Phase;
 use serde::{Deserialize, Serialize};
+use tendril_fbg::array::{ArrayPeaks, PerPad};
 use tendril_fbg::signals::Wavelengths;
 
 /// Standard gravity \[m/s²\] (ISO 80000-3), for the weights the control side reasons about.
@@ -41,8 +42,10 @@ pub struct CellState {
     pub growth_motor_rad: f64,
     /// Measured twine motor position \[rad\] (the MX-106 pulling the curl tendon).
     pub twine_motor_rad: f64,
-    /// The latest interrogator sample.
+    /// The latest interrogator sample (of pad 0, the paper's pad).
     pub wavelengths: Wavelengths,
+    /// The further pads' samples of a sensor array, taken with pad 0's (empty without one).
+    pub array: ArrayPeaks,
     /// The vertical load the tool carries \[N\], positive downward: what the arm's wrist force
     /// sensor reads of the held object (and anything else pressing on the tool), its own payload
     /// compensated. A UR5e reports it as minus the z component of RTDE `actual_TCP_force` (the
@@ -66,6 +69,8 @@ pub struct CellCommand {
 pub struct GroundTruth {
     /// True normal force on the sensor bump \[N\].
     pub sensor_force_n: f64,
+    /// True normal force on each further pad of a sensor array \[N\] (empty without one).
+    pub array_force_n: PerPad<f64>,
     /// Total normal force between finger and object \[N\].
     pub grip_force_n: f64,
     /// Height of the object's footprint centre (its body origin) above the table top \[m\]: 0 while it

@@ -212,6 +212,7 @@ mod tests {
                 growth_motor_rad: 0.0,
                 twine_motor_rad: self.twine,
                 wavelengths: self.w,
+                array: Default::default(),
                 tool_load_n: None,
             })
         }

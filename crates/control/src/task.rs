@@ -467,6 +467,7 @@ mod tests {
                 growth_motor_rad: 0.0,
                 twine_motor_rad: twine_deg.to_radians(),
                 wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+                array: Default::default(),
                 tool_load_n: None,
             };
             let d = seq.update(&state, force, dt);
@@ -554,6 +555,7 @@ mod tests {
             growth_motor_rad: 0.0,
             twine_motor_rad: 0.0,
             wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+            array: Default::default(),
             tool_load_n: None,
         };
         seq.update(&state, 0.5, 0.01);

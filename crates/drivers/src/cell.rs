@@ -490,6 +490,7 @@ impl Cell for RealCell {
             growth_motor_rad,
             twine_motor_rad,
             wavelengths: latest.wavelengths,
+            array: Default::default(),
             tool_load_n: latest.tool_load_n,
         })
     }

@@ -10,3 +10,10 @@ pub struct Wavelengths {
     /// FBG2 (near 1550 nm, strain-free in the tube: temperature only), in nm.
     pub fbg2_nm: f64,
 }
+
+impl Default for Wavelengths {
+    /// No sample: both peaks NaN.
+    fn default() -> Self {
+        Wavelengths { fbg1_nm: f64::NAN, fbg2_nm: f64::NAN }
+    }
+}

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+mod array_estimates;
 mod backend_defaults;
 pub mod clock;
 pub mod compare;
@@ -13,6 +14,7 @@ pub mod plan;
 pub mod real;
 pub mod report;
 pub mod runner;
+mod samples;
 pub mod scenario;
 pub mod session;
 pub mod summary;

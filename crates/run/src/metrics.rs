@@ -45,9 +45,9 @@ fn band_swings(rows: &[&TraceRow]) -> usize {
     let mut last: Option<bool> = None;
     let mut swings = 0;
     for r in rows {
-        let side = if r.force_n > 1.1 * r.setpoint_n {
+        let side = if r.controlled_n() > 1.1 * r.setpoint_n {
             Some(true)
-        } else if r.force_n < 0.9 * r.setpoint_n {
+        } else if r.controlled_n() < 0.9 * r.setpoint_n {
             Some(false)
         } else {
             None
@@ -74,7 +74,7 @@ pub const SPIKE_FILTER_TICKS: usize = 5;
 
 /// The rows' estimates through [`despiked`].
 fn despiked_force(rows: &[&TraceRow]) -> Vec<f64> {
-    despiked(&rows.iter().map(|r| r.force_n).collect::<Vec<_>>())
+    despiked(&rows.iter().map(|r| r.controlled_n()).collect::<Vec<_>>())
 }
 
 /// A signal sampled once per control tick through a centred running median of
@@ -115,8 +115,9 @@ pub fn max_fluctuation_pct(
     counts: impl Fn(&TraceRow) -> bool,
 ) -> Option<f64> {
     let moving: Vec<&TraceRow> = rows.iter().filter(|r| r.phase.arm_moving() && counts(r)).collect();
-    (drop_time_s.is_none() && !moving.is_empty())
-        .then(|| moving.iter().map(|r| 100.0 * (r.force_n - r.setpoint_n).abs() / r.setpoint_n).fold(0.0, f64::max))
+    (drop_time_s.is_none() && !moving.is_empty()).then(|| {
+        moving.iter().map(|r| 100.0 * (r.controlled_n() - r.setpoint_n).abs() / r.setpoint_n).fold(0.0, f64::max)
+    })
 }
 
 /// [`ControlMetrics::max_fluctuation_outside_push_pct`] for a run pushed by `push`: the ticks from
@@ -145,14 +146,14 @@ pub fn control_metrics(rows: &[TraceRow], drop_time_s: Option<f64>) -> ControlMe
     let moving: Vec<&TraceRow> =
         rows.iter().filter(|r| r.phase.arm_moving() && drop_time_s.is_none_or(|d| r.time_s < d)).collect();
     let max_fluctuation_pct = max_fluctuation_pct(rows, drop_time_s, |_| true);
-    let min_moving_force_n = moving.iter().map(|r| r.force_n).reduce(f64::min);
+    let min_moving_force_n = moving.iter().map(|r| r.controlled_n()).reduce(f64::min);
     let compared: Vec<f64> = rows
         .iter()
         .filter(|r| r.phase.holding() && r.true_force_n.is_finite())
         .map(|r| (r.force_n - r.true_force_n).powi(2))
         .collect();
     let force_rmse_n = (!compared.is_empty()).then(|| (compared.iter().sum::<f64>() / compared.len() as f64).sqrt());
-    let settled: Vec<&TraceRow> = grasp.iter().copied().skip_while(|r| r.force_n < 0.9 * r.setpoint_n).collect();
+    let settled: Vec<&TraceRow> = grasp.iter().copied().skip_while(|r| r.controlled_n() < 0.9 * r.setpoint_n).collect();
     let oscillating = band_swings(&settled) >= OSCILLATION_SWINGS;
     let held: Vec<&TraceRow> =
         rows.iter().filter(|r| r.phase.holding() && drop_time_s.is_none_or(|d| r.time_s < d)).collect();

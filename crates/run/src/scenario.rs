@@ -17,8 +17,9 @@ use tendril_control::ControllerConfig;
 use tendril_control::slip::SlipConfig;
 use tendril_control::task::TaskConfig;
 use tendril_drivers::HardwareConfig;
+use tendril_fbg::array::ArrayConfig;
 use tendril_fbg::estimate::ForceCalibration;
-use tendril_fbg::{InterrogatorConfig, SensorConfig};
+use tendril_fbg::{InterrogatorConfig, InterrogatorMode, SensorConfig};
 use tendril_twin::disturbance::DisturbanceConfig;
 use tendril_twin::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneModel, SceneSpec};
 use tendril_twin::sim::{EnvironmentConfig, SimCell};
@@ -70,6 +71,10 @@ pub struct PickPlaceScenario {
     /// The interrogator.
     #[serde(default)]
     pub interrogator: InterrogatorConfig,
+    /// Further FBG pads along the finger (a sensor array) and what the controller regulates over
+    /// them; none by default: the paper's single pad (docs/cell/array.md).
+    #[serde(default, skip_serializing_if = "ArrayConfig::is_single")]
+    pub array: ArrayConfig,
     /// Temperature at the sensor.
     #[serde(default)]
     pub environment: EnvironmentConfig,
@@ -162,6 +167,8 @@ impl Validate for PickPlaceScenario {
             format!("must not exceed finger.length_m ({} m)", self.finger.length_m)
         });
         self.check_gratings_in_windows(at);
+        at.section("array", &self.array);
+        self.check_array(at);
     }
 }
 
@@ -171,6 +178,7 @@ impl PickPlaceScenario {
         SimCell::new(model, self.sensor.clone(), self.interrogator.clone(), self.gripper, self.environment, self.seed)
             .with_disturbances(self.disturbance.clone())
             .with_wrist(self.wrist)
+            .with_array(&self.array)
     }
 
     /// The FBG windows must hold the gratings `[sensor]` describes (the twin behind `tendril serve`
@@ -196,12 +204,52 @@ impl PickPlaceScenario {
         });
     }
 
+    /// A sensor array's pads must sit on the strip without touching one another or the tip's
+    /// anchor, and its gratings must be told apart by the interrogator
+    /// ([`ArrayConfig::multiplexing_faults`]).
+    fn check_array(&self, at: &mut Checker) {
+        use tendril_twin::physics::strip::{PAD_HALF_LENGTH_M, TIP_LENGTH_M};
+        if self.array.is_single() {
+            return;
+        }
+        let tip = self.finger.length_m - TIP_LENGTH_M.min(self.finger.length_m / 4.0);
+        let casing = 2.0 * PAD_HALF_LENGTH_M;
+        for (i, p) in self.array.pads.iter().enumerate() {
+            let key = format!("array.pads[{i}].arc_m");
+            at.require(&key, p.arc_m - PAD_HALF_LENGTH_M >= 0.0 && p.arc_m + PAD_HALF_LENGTH_M <= tip, || {
+                format!(
+                    "the pad's 12 mm casing must sit on the strip between its base and the tip's anchor \
+                     ({PAD_HALF_LENGTH_M} .. {:.4} m), got {}",
+                    tip - PAD_HALF_LENGTH_M,
+                    p.arc_m
+                )
+            });
+            let others = std::iter::once(("finger.pad_position_m".to_string(), self.finger.pad_position_m)).chain(
+                self.array.pads[..i].iter().enumerate().map(|(j, q)| (format!("array.pads[{j}].arc_m"), q.arc_m)),
+            );
+            for (other, at_m) in others {
+                at.require(&key, (p.arc_m - at_m).abs() >= casing - 1e-12, || {
+                    format!("the pad's casing overlaps {other}'s ({} m): centres at least 12 mm apart", at_m)
+                });
+            }
+        }
+        at.require("array.pads", self.interrogator.mode == InterrogatorMode::Analytic, || {
+            "a sensor array is read in interrogator.mode = \"analytic\" only (the spectral model has one \
+             strain and one reference line)"
+                .into()
+        });
+        for (key, reason) in self.array.multiplexing_faults(&self.sensor, self.hardware.fbg.channel) {
+            at.require(&key, false, || reason);
+        }
+    }
+
     /// The physics scene this scenario needs (arm starting at the task's home pose).
     pub fn scene_spec(&self) -> SceneSpec {
         SceneSpec {
             physics: self.physics.clone(),
             finger: self.finger.clone(),
             object: Some(self.object.clone()),
+            extra_pads_m: self.array.pads.iter().map(|p| p.arc_m).collect(),
             arm_q0: self.task.home_deg.map(f64::to_radians),
         }
     }
@@ -244,6 +292,7 @@ impl PickPlaceScenario {
             gripper: self.gripper,
             slip: self.slip,
             object_weight_n: Some(self.object_mass_kg() * tendril_cell::G_M_S2).filter(|w| w.is_finite()),
+            array_control: self.array.control,
         }
     }
 }

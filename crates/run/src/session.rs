@@ -16,16 +16,19 @@
 //! controller, a notebook): each [`Action`] either lets the configured controller act or takes its
 //! place for the tick.
 
+use super::array_estimates::ArrayEstimates;
 use super::drop_watch::DropWatch;
 use super::metrics::control_metrics;
 use super::plan::ControlPlan;
-use super::report::{Drop, MAX_CONSECUTIVE_INVALID_SAMPLES, Outcome, RunReport};
-use super::trace::{TraceRow, TraceWriter};
+use super::report::{Drop, Outcome, RunReport};
+use super::samples::{InvalidSamples, TareAverager};
+use super::trace::{ArrayRow, PadRow, TraceRow, TraceWriter};
 use tendril_cell::{Cell, CellError, CellState, GroundTruth, Phase, Wavelengths};
 use tendril_control::controller::ForceController;
 use tendril_control::slip::{ArmReading, SlipDetector, judge};
 use tendril_control::task::{ControlAction, TaskSequencer};
-use tendril_fbg::estimate::{Estimate, EstimateError, ForceEstimator};
+use tendril_fbg::array::{MAX_PADS, PerPad};
+use tendril_fbg::estimate::{Estimate, ForceEstimator};
 
 /// What drives the force loop this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -54,6 +57,11 @@ pub struct Observation {
     /// The force estimate (eq. 8) the next step uses (held when the sample was not new or was
     /// invalid).
     pub estimate: Estimate,
+    /// The further pads' force estimates of a sensor array \[N\] (empty without one).
+    pub array_estimate_n: PerPad<f64>,
+    /// The force the controller regulates \[N\]: `estimate.force_n`, or with a sensor array the
+    /// signal `array.control` names over all pads.
+    pub control_force_n: f64,
     /// The task's force setpoint \[N\].
     pub setpoint_n: f64,
     /// Time to the arm's next move \[s\]: counts down in the grasp, 0 while it moves, +∞ when no
@@ -69,6 +77,10 @@ pub struct Observation {
 struct Pending {
     state: CellState,
     estimate: Estimate,
+    /// The further pads' estimates \[N\].
+    array: PerPad<f64>,
+    /// The force the controller regulates \[N\].
+    control_force_n: f64,
 }
 
 /// One run in progress (see the module docs).
@@ -78,6 +90,7 @@ pub struct Session<C: Cell> {
     sequencer: TaskSequencer,
     estimator: ForceEstimator,
     tare: TareAverager,
+    array: ArrayEstimates,
     unloaded_n: f64,
     invalid: InvalidSamples,
     slip: SlipDetector,
@@ -118,6 +131,7 @@ impl<C: Cell> Session<C> {
             plan: plan.clone(),
             sequencer,
             tare: TareAverager::default(),
+            array: ArrayEstimates::default(),
             unloaded_n: 0.0,
             invalid: InvalidSamples::default(),
             slip,
@@ -148,6 +162,8 @@ impl<C: Cell> Session<C> {
             phase: self.sequencer.phase(),
             wavelengths: p.state.wavelengths,
             estimate: p.estimate,
+            array_estimate_n: p.array,
+            control_force_n: p.control_force_n,
             setpoint_n: self.sequencer.setpoint_n(),
             time_to_motion_s: self.sequencer.time_to_motion_s(p.state.time_s),
             state: p.state,
@@ -268,6 +284,7 @@ impl<C: Cell> Session<C> {
             self.estimator.tare(mean);
             self.unloaded_n = self.estimator.estimate(mean).map_or(0.0, |e| e.force_n);
             self.sequencer.set_unloaded_reading(self.unloaded_n);
+            self.array.tare(&state.array, &self.plan.calibration);
         }
         if self.sequencer.phase() == Phase::Home {
             self.slip.observe_home_load(state.tool_load_n);
@@ -282,18 +299,29 @@ impl<C: Cell> Session<C> {
                 cause: format!("at t = {:.3} s: {cause}", state.time_s),
             })?,
         };
-        Ok(Pending { state, estimate })
+        let array = self.array.estimate(&state.array, held.is_some(), &self.plan.calibration).map_err(|cause| {
+            CellError::Device { device: "estimator".into(), cause: format!("at t = {:.3} s: {cause}", state.time_s) }
+        })?;
+        let control_force_n = if array.is_empty() {
+            estimate.force_n
+        } else {
+            let mut all = [0.0; MAX_PADS];
+            all[0] = estimate.force_n;
+            all[1..=array.len()].copy_from_slice(array.as_slice());
+            self.plan.array_control.of(&all[..=array.len()])
+        };
+        Ok(Pending { state, estimate, array, control_force_n })
     }
 
     /// Sequences and controls on a reading, writes the command, records the tick.
     fn act(&mut self, p: Pending, action: Action) -> Result<TraceRow, CellError> {
-        let (state, estimate) = (p.state, p.estimate);
+        let (state, estimate, force_n) = (p.state, p.estimate, p.control_force_n);
         let control = match action {
             Action::Controller => ControlAction::Controller,
             Action::TwineSpeed(deg_s) => ControlAction::TwineSpeed(deg_s),
             Action::Setpoint(n) => ControlAction::Setpoint(n),
         };
-        let decision = self.sequencer.update_with(&state, estimate.force_n, self.dt_s, control);
+        let decision = self.sequencer.update_with(&state, force_n, self.dt_s, control);
         if self.last_phase != Some(decision.phase) {
             self.cell.phase_started(decision.phase, state.time_s);
             self.last_phase = Some(decision.phase);
@@ -301,7 +329,7 @@ impl<C: Cell> Session<C> {
         // Slip is watched while the arm carries the object, as in the paper.
         self.slip.update(
             state.time_s,
-            estimate.force_n,
+            force_n,
             ArmReading::from_joints(&state.arm_q, state.tool_load_n),
             self.unloaded_n,
             self.sequencer.reading_noise_n(),
@@ -333,6 +361,7 @@ impl<C: Cell> Session<C> {
             slip_speed_m_s: truth.map_or(nan, |t| t.slip_speed_m_s),
             grip_force_n: truth.map_or(nan, |t| t.grip_force_n),
             tool_load_n: state.tool_load_n.unwrap_or(nan),
+            array: array_row(&state, truth.as_ref(), &p.array, force_n),
         };
         if let Some(w) = self.trace.as_mut() {
             w.write(&row).map_err(|e| CellError::Device { device: "trace".into(), cause: e.to_string() })?;
@@ -373,7 +402,7 @@ impl<C: Cell> Session<C> {
             metrics,
             cell_time_s: rows.last().map_or(0.0, |r| r.time_s),
             error,
-            invalid_samples: self.invalid.total,
+            invalid_samples: self.invalid.total + self.array.invalid_total(),
             dropped_samples: self.dropped_samples,
             rows,
             device_timing,
@@ -382,60 +411,27 @@ impl<C: Cell> Session<C> {
     }
 }
 
-/// Skips invalid estimates, holding the last valid one, until too many come in a row.
-#[derive(Debug, Default)]
-struct InvalidSamples {
-    last_valid: Option<Estimate>,
-    consecutive: u32,
-    total: u64,
-}
-
-impl InvalidSamples {
-    /// The estimate to use this tick, or why the run must stop: no tare, or
-    /// [`MAX_CONSECUTIVE_INVALID_SAMPLES`] invalid samples in a row (or one before any valid).
-    fn check(&mut self, estimate: Result<Estimate, EstimateError>) -> Result<Estimate, String> {
-        match estimate {
-            Ok(e) => {
-                self.consecutive = 0;
-                self.last_valid = Some(e);
-                Ok(e)
-            }
-            Err(e @ EstimateError::NotTared) => Err(e.to_string()),
-            Err(e) => {
-                self.consecutive += 1;
-                self.total += 1;
-                match self.last_valid {
-                    Some(held) if self.consecutive < MAX_CONSECUTIVE_INVALID_SAMPLES => Ok(held),
-                    Some(_) => Err(format!("{} consecutive invalid samples, the last: {e}", self.consecutive)),
-                    None => Err(format!("no valid sample yet: {e}")),
-                }
-            }
-        }
+/// A sensor array's columns of a tick: each further pad's truth, peaks and estimate.
+fn array_row(
+    state: &CellState,
+    truth: Option<&GroundTruth>,
+    estimates: &PerPad<f64>,
+    control_force_n: f64,
+) -> ArrayRow {
+    let mut pads = PerPad::filled(state.array.len(), PadRow::default());
+    for (k, row) in pads.as_mut_slice().iter_mut().enumerate() {
+        let w = state.array.as_slice()[k];
+        *row = PadRow {
+            true_force_n: truth.and_then(|t| t.array_force_n.as_slice().get(k).copied()).unwrap_or(f64::NAN),
+            fbg1_nm: w.fbg1_nm,
+            fbg2_nm: w.fbg2_nm,
+            force_n: estimates.as_slice().get(k).copied().unwrap_or(f64::NAN),
+        };
     }
+    ArrayRow { pads, control_force_n }
 }
 
 /// The phase of the last row at or before `time_s`.
 fn phase_at(rows: &[TraceRow], time_s: f64) -> Phase {
     rows.iter().rev().find(|r| r.time_s <= time_s).map_or(Phase::Home, |r| r.phase)
-}
-
-/// Running mean of wavelength samples, for the tare.
-#[derive(Debug, Default)]
-struct TareAverager {
-    sum1: f64,
-    sum2: f64,
-    n: u32,
-}
-
-impl TareAverager {
-    fn add(&mut self, w: Wavelengths) {
-        self.sum1 += w.fbg1_nm;
-        self.sum2 += w.fbg2_nm;
-        self.n += 1;
-    }
-
-    fn mean(&self) -> Wavelengths {
-        let n = f64::from(self.n.max(1));
-        Wavelengths { fbg1_nm: self.sum1 / n, fbg2_nm: self.sum2 / n }
-    }
 }

@@ -3,6 +3,30 @@
 use std::io::Write;
 use std::path::Path;
 use tendril_control::task::Phase;
+use tendril_fbg::array::PerPad;
+
+/// One further pad of a sensor array at one tick (pad 0's are the row's own columns).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PadRow {
+    /// True normal force on the pad \[N\] (NaN without ground truth).
+    pub true_force_n: f64,
+    /// Its strain grating's peak \[nm\].
+    pub fbg1_nm: f64,
+    /// Its reference grating's peak \[nm\] (pad 0's when it shares that one).
+    pub fbg2_nm: f64,
+    /// Its force estimate, eq. (8) \[N\].
+    pub force_n: f64,
+}
+
+/// A sensor array's columns of one tick: each further pad's, and the force the controller
+/// regulated over all pads (`array.control`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ArrayRow {
+    /// The further pads (empty without an array: the trace then has no array columns).
+    pub pads: PerPad<PadRow>,
+    /// The force the controller regulated \[N\]: pad 0's estimate, the pads' total or their largest.
+    pub control_force_n: f64,
+}
 
 /// One control tick, as written to `trace.csv`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +65,16 @@ pub struct TraceRow {
     pub grip_force_n: f64,
     /// The tool's load as the wrist force sensor reads it \[N\] (NaN without one).
     pub tool_load_n: f64,
+    /// A sensor array's further pads (empty without one).
+    pub array: ArrayRow,
+}
+
+impl TraceRow {
+    /// The force the controller regulated \[N\]: pad 0's estimate (`force_n`), or with a sensor
+    /// array the signal `array.control` names. What the run's metrics judge.
+    pub fn controlled_n(&self) -> f64 {
+        if self.array.pads.is_empty() { self.force_n } else { self.array.control_force_n }
+    }
 }
 
 impl TraceRow {
@@ -65,6 +99,7 @@ impl TraceRow {
             slip_speed_m_s: 0.0,
             grip_force_n: 0.0,
             tool_load_n: 0.0,
+            array: ArrayRow::default(),
         }
     }
 }
@@ -84,6 +119,9 @@ const BUFFER_BYTES: usize = 8 * 1024;
 pub struct TraceWriter {
     file: std::fs::File,
     buffer: Vec<u8>,
+    /// Whether the header is in the buffer or on disk (it goes with the first row, which says
+    /// whether the run has array columns).
+    header: bool,
     /// Length of the file's whole rows on disk.
     written: u64,
     error: Option<String>,
@@ -92,8 +130,13 @@ pub struct TraceWriter {
 impl TraceWriter {
     /// Creates (truncates) `path`; the header goes out with the first rows.
     pub fn create(path: &Path) -> std::io::Result<TraceWriter> {
-        let buffer = format!("{HEADER}\n").into_bytes();
-        Ok(TraceWriter { file: std::fs::File::create(path)?, buffer, written: 0, error: None })
+        Ok(TraceWriter {
+            file: std::fs::File::create(path)?,
+            buffer: Vec::new(),
+            header: false,
+            written: 0,
+            error: None,
+        })
     }
 
     /// Writes the collected rows; on failure cuts the file back to the rows written before.
@@ -126,8 +169,19 @@ impl TraceWriter {
             // After a failure no row is written: the trace stays a prefix of the run.
             return Err(std::io::Error::other(e.clone()));
         }
+        if !self.header {
+            self.header = true;
+            self.buffer.extend_from_slice(HEADER.as_bytes());
+            for k in 1..=r.array.pads.len() {
+                write!(self.buffer, ",pad{k}_true_force_n,pad{k}_fbg1_nm,pad{k}_fbg2_nm,pad{k}_force_n")?;
+            }
+            if !r.array.pads.is_empty() {
+                self.buffer.extend_from_slice(b",control_force_n");
+            }
+            self.buffer.push(b'\n');
+        }
         // Formatted straight into the row buffer: no allocation per control tick.
-        writeln!(
+        write!(
             self.buffer,
             "{:.4},{},{:.5},{:.4},{:.4},{:.5},{:.5},{},{:.3},{},{:.3},{:.5},{:.5},{:.5},{:.5},{:.4},{:.3}",
             r.time_s,
@@ -148,11 +202,24 @@ impl TraceWriter {
             r.grip_force_n,
             r.tool_load_n,
         )?;
+        for p in r.array.pads.as_slice() {
+            write!(self.buffer, ",{:.5},{:.4},{:.4},{:.5}", p.true_force_n, p.fbg1_nm, p.fbg2_nm, p.force_n)?;
+        }
+        if !r.array.pads.is_empty() {
+            write!(self.buffer, ",{:.5}", r.array.control_force_n)?;
+        }
+        self.buffer.push(b'\n');
         if self.buffer.len() >= BUFFER_BYTES { self.flush_rows() } else { Ok(()) }
     }
 
     /// Writes every collected row and syncs the file to disk.
     pub fn flush(&mut self) -> std::io::Result<()> {
+        if !self.header && self.error.is_none() {
+            // A run that ended before its first row still leaves a trace with its header.
+            self.header = true;
+            self.buffer.extend_from_slice(HEADER.as_bytes());
+            self.buffer.push(b'\n');
+        }
         self.flush_rows()?;
         let synced = self.file.sync_data();
         self.keep(synced)

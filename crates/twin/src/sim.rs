@@ -13,6 +13,7 @@ use tendril_cell::Phase;
 use tendril_cell::gripper::GripperConfig;
 use tendril_cell::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
 use tendril_config::{Checker, Validate};
+use tendril_fbg::array::{ArrayConfig, ArrayPeaks};
 use tendril_fbg::signals::Wavelengths;
 use tendril_fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
 
@@ -62,6 +63,10 @@ pub struct SimCell {
     seed: u64,
     lifecycle: Lifecycle,
     latest: Wavelengths,
+    /// The further pads of a sensor array ([`SimCell::with_array`]): their sensor models.
+    array: Vec<PadSensor>,
+    /// Their latest samples.
+    latest_array: ArrayPeaks,
     next_sample_s: f64,
     /// The physics readout after the last step, read once per tick by `read`, the sensor and
     /// the ground truth alike.
@@ -81,7 +86,41 @@ pub struct SimCell {
     count_contacts: bool,
 }
 
+/// A further pad's sensor model, and whether it reads pad 0's reference grating instead of its own.
+#[derive(Debug, Clone)]
+struct PadSensor {
+    config: SensorConfig,
+    model: FbgSensor,
+    shares_reference: bool,
+}
+
+/// The noise seed of further pad `k` (1-based) of a run seeded `seed`: its own stream, so adding a
+/// pad leaves every other pad's noise as it was (pad 0 keeps `seed` itself). The step is the
+/// 64-bit golden ratio, which spreads consecutive `k` over the whole range.
+fn pad_seed(seed: u64, k: usize) -> u64 {
+    seed.wrapping_add(0x9E37_79B9_7F4A_7C15_u64.wrapping_mul(k as u64))
+}
+
 impl SimCell {
+    /// Reads the further pads of `array` besides pad 0 (`[array]`): each its own sensor model
+    /// (`sensor` with the pad's wavelengths) and noise stream, sampled at pad 0's instants with
+    /// its own contact force. The scene must carry the same pads (`SceneSpec::extra_pads_m`);
+    /// [`Cell::configure`] refuses it otherwise.
+    pub fn with_array(mut self, array: &ArrayConfig) -> SimCell {
+        self.array = (1..=array.pads.len())
+            .map(|k| {
+                let config = array.pad_sensor(&self.sensor_config, k);
+                PadSensor {
+                    model: FbgSensor::new(&config, &self.interrogator, pad_seed(self.seed, k)),
+                    config,
+                    shares_reference: array.pads[k - 1].lambda2_nm.is_none(),
+                }
+            })
+            .collect();
+        self.latest_array = ArrayPeaks::filled(self.array.len(), Wavelengths::default());
+        self
+    }
+
     /// Commands the growth and twine motors \[rad\] only. The arm's command stays as it is, and with
     /// it the interval over which the kinematic arm moves to its target (the time between two arm
     /// commands): for a caller that updates the motors more often than arm targets arrive, as the
@@ -165,6 +204,8 @@ impl SimCell {
             seed,
             lifecycle: Lifecycle::Unconfigured,
             latest: Wavelengths { fbg1_nm: 0.0, fbg2_nm: 0.0 },
+            array: Vec::new(),
+            latest_array: ArrayPeaks::default(),
             next_sample_s: 0.0,
             readout: PhysicsReadout::default(),
             disturbances: DisturbanceSchedule::default(),
@@ -251,9 +292,20 @@ impl SimCell {
             // The sensor model runs through a dropout (its noise and thermal state advance); only
             // the delivery is lost. The first sample (the activation's) is always delivered.
             let sample = self.sensor.sample(force, temperature, dt);
-            if self.next_sample_s == 0.0 || !self.disturbances.sample_dropped(self.next_sample_s) {
+            let deliver = self.next_sample_s == 0.0 || !self.disturbances.sample_dropped(self.next_sample_s);
+            if deliver {
                 self.latest = sample;
                 self.fresh_sample = true;
+            }
+            let forces = self.readout.extra_pad_forces_n;
+            for (k, pad) in self.array.iter_mut().enumerate() {
+                let mut w = pad.model.sample(forces.as_slice()[k], temperature, dt);
+                if pad.shares_reference {
+                    w.fbg2_nm = sample.fbg2_nm;
+                }
+                if deliver {
+                    self.latest_array.as_mut_slice()[k] = w;
+                }
             }
             self.next_sample_s += dt;
         }
@@ -277,6 +329,16 @@ impl Cell for SimCell {
         }
         self.scene = Some(scene);
         self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
+        for (k, pad) in self.array.iter_mut().enumerate() {
+            pad.model = FbgSensor::new(&pad.config, &self.interrogator, pad_seed(self.seed, k + 1));
+        }
+        let pads_in_scene = self.model.spec().extra_pads_m.len();
+        if pads_in_scene != self.array.len() {
+            return Err(CellError::Configure(format!(
+                "the sensor array reads {} further pads, the scene carries {pads_in_scene}",
+                self.array.len()
+            )));
+        }
         self.wrist = WristSensor::new(&self.wrist_config, self.seed);
         self.next_sample_s = 0.0;
         self.disturbances.restart();
@@ -312,6 +374,7 @@ impl Cell for SimCell {
             growth_motor_rad: self.gripper.growth_motor_rad(r.growth_m),
             twine_motor_rad: r.twine_m / self.gripper.twine_spool_radius_m,
             wavelengths: self.latest,
+            array: self.latest_array,
             tool_load_n: r
                 .tool_load_n
                 .filter(|_| self.wrist_config.present)
@@ -361,6 +424,7 @@ impl Cell for SimCell {
         let r = &self.readout;
         Some(GroundTruth {
             sensor_force_n: r.pad_force_n,
+            array_force_n: r.extra_pad_forces_n,
             grip_force_n: r.grip_force_n,
             object_height_m: r.object_pos_m[2] - self.model.placement().table_z,
             slip_speed_m_s: r.slip_speed_m_s,

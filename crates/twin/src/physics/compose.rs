@@ -116,25 +116,35 @@ pub fn header(p: &PhysicsConfig) -> String {
 
 /// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
 /// document whose hand body goes into the arm's flange.
-pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, PhysicsError> {
+/// With `extra_pads_m`, further sensor pads (a sensor array) sit on the strip at those arcs, each
+/// a copy of `sensor_pad.xml` whose names carry its number (`pad1_casing`, ...).
+pub fn finger(f: &FingerConfig, extra_pads_m: &[f64], models: Option<&Path>) -> Result<String, PhysicsError> {
     let (finger_text, segment_text, pad_text) =
         (part(models, "finger.xml")?, part(models, "finger_segment.xml")?, part(models, "sensor_pad.xml")?);
-    let pieces = super::strip::layout(f);
+    let pieces = super::strip::layout_with_pads(f, extra_pads_m);
     let r = f.thickness_m / 2.0;
-    let pad_seg = pieces.iter().position(|p| p.fixed).unwrap_or(0);
-    let pad_x = f.pad_position_m - pieces[pad_seg].start_m;
     // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
     let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
-    let pad = render(
-        body_of(&pad_text),
-        &[
-            ("x", num(pad_x)),
-            ("r", num(r)),
-            ("casing_y", num(r + 0.002 + sink)),
-            ("bump_y", num(r + 0.004 + sink)),
-            ("site_y", num(r + 0.005 + sink)),
-        ],
-    )?;
+    let pad_at = |centre: f64| -> Result<(usize, String), PhysicsError> {
+        let seg = super::strip::pad_piece(&pieces, centre);
+        let xml = render(
+            body_of(&pad_text),
+            &[
+                ("x", num(centre - pieces[seg].start_m)),
+                ("r", num(r)),
+                ("casing_y", num(r + 0.002 + sink)),
+                ("bump_y", num(r + 0.004 + sink)),
+                ("site_y", num(r + 0.005 + sink)),
+            ],
+        )?;
+        Ok((seg, xml))
+    };
+    let mut pads = vec![pad_at(f.pad_position_m)?];
+    for (k, &centre) in extra_pads_m.iter().enumerate() {
+        let (seg, xml) = pad_at(centre)?;
+        pads.push((seg, xml.replace("name=\"pad_", &format!("name=\"pad{}_", k + 1))));
+    }
+    let pads_on = |i: usize| pads.iter().filter(|(seg, _)| *seg == i).map(|(_, xml)| xml.as_str()).collect::<String>();
     let segment_body = body_of(&segment_text);
     let rigid_body = without_joint(segment_body);
     // A joint between two rigid pieces stands for no strip: the pieces are welded.
@@ -160,7 +170,7 @@ pub fn finger(f: &FingerConfig, models: Option<&Path>) -> Result<String, Physics
                 ("half_width", num(f.width_m / 2.0)),
                 ("radius", num(r)),
                 ("mass", num(f.density_kg_m3 * l * f.width_m * f.thickness_m)),
-                ("pad", if i == pad_seg { pad.clone() } else { String::new() }),
+                ("pad", pads_on(i)),
                 ("child", chain),
             ],
         )?;
@@ -254,7 +264,7 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     }
     // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
     // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
-    let finger_doc = finger(&spec.finger, models)?;
+    let finger_doc = finger(&spec.finger, &spec.extra_pads_m, models)?;
     let arm = render(&part(models, "ur5e.xml")?, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
     worldbody.push_str(section(&arm, "worldbody"));
     if spec.physics.arm_mode == ArmMode::Dynamic {

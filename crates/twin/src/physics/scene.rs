@@ -11,6 +11,7 @@ use mujoco_rs::prelude::{MjData, MjModel};
 use nalgebra::{Isometry3, Vector3};
 use std::sync::Arc;
 use tendril_config::{Checker, Validate};
+use tendril_fbg::array::PerPad;
 
 /// The quaternion (w, x, y, z) of a turn by `yaw_deg` about the vertical.
 pub(crate) fn yaw_quaternion(yaw_deg: f64) -> [f64; 4] {
@@ -38,6 +39,8 @@ pub struct SceneModel {
 pub(crate) struct Ids {
     /// Geoms of the sensor pad (casing, bump).
     pub(crate) pad_geoms: Vec<usize>,
+    /// Geoms of each further pad of a sensor array (`SceneSpec::extra_pads_m`).
+    pub(crate) extra_pad_geoms: Vec<Vec<usize>>,
     /// Geoms of the strip and the pad.
     pub(crate) finger_geoms: Vec<usize>,
     /// The palm beside the guide exit.
@@ -143,7 +146,11 @@ impl SceneModel {
         let act = |n: &str| id(m, mjOBJ_ACTUATOR, "actuator", n);
         let pad_geoms = vec![geom("pad_casing")?, geom("pad_bump")?];
         let mut finger_geoms = pad_geoms.clone();
-        for i in 0..super::strip::layout(&spec.finger).len() {
+        let extra_pad_geoms = (1..=spec.extra_pads_m.len())
+            .map(|k| Ok(vec![geom(&format!("pad{k}_casing"))?, geom(&format!("pad{k}_bump"))?]))
+            .collect::<Result<Vec<_>, PhysicsError>>()?;
+        finger_geoms.extend(extra_pad_geoms.iter().flatten());
+        for i in 0..super::strip::layout_with_pads(&spec.finger, &spec.extra_pads_m).len() {
             finger_geoms.push(geom(&format!("seg{i}"))?);
         }
         let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() {
@@ -188,6 +195,7 @@ impl SceneModel {
         let touch = id(m, mjOBJ_SENSOR, "sensor", "pad_touch")?;
         Ok(Ids {
             pad_geoms,
+            extra_pad_geoms,
             finger_geoms,
             palm_geom: vec![geom("palm")?],
             hand_geoms,
@@ -275,6 +283,8 @@ pub struct PhysicsReadout {
     pub time_s: f64,
     /// Normal force of the object on the sensor pad (casing and bump) \[N\]: the FBG sensor's input.
     pub pad_force_n: f64,
+    /// Normal force of the object on each further pad of a sensor array \[N\] (empty without one).
+    pub extra_pad_forces_n: PerPad<f64>,
     /// Sum of the normal forces between the object and the whole finger, pad included \[N\].
     pub grip_force_n: f64,
     /// Normal force between the object and the palm beside the guide exit \[N\] (not part of the grip
@@ -688,6 +698,10 @@ impl Physics for Scene {
         let ids = &self.shared.ids;
         let qpos = self.data.qpos();
         let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
+        let mut extra_pad_forces_n = PerPad::filled(ids.extra_pad_geoms.len(), 0.0);
+        for (f, geoms) in extra_pad_forces_n.as_mut_slice().iter_mut().zip(&ids.extra_pad_geoms) {
+            *f = self.normal_force_between(geoms, &ids.object_geoms).0;
+        }
         let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
         let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
         let tool_load_n = Some(self.vertical_force_on(&ids.hand_geoms, &ids.object_geoms));
@@ -698,6 +712,7 @@ impl Physics for Scene {
         let mut r = PhysicsReadout {
             time_s: self.data.time(),
             pad_force_n,
+            extra_pad_forces_n,
             grip_force_n,
             palm_force_n,
             grip_contacts,

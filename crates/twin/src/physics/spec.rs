@@ -13,6 +13,10 @@ pub struct SceneSpec {
     pub finger: FingerConfig,
     /// The object (and with it the table); `None` for a finger-only scene.
     pub object: Option<ObjectConfig>,
+    /// Centres of further sensor pads along the strip \[m of arc\] (a sensor array, `[array]`);
+    /// empty: the paper's single pad at `finger.pad_position_m`. Each is a pad like pad 0, named
+    /// `pad{k}_casing`, `pad{k}_bump`, `pad{k}_site` (k = 1, 2, ...).
+    pub extra_pads_m: Vec<f64>,
     /// Start joint angles of the arm \[rad\]. The object is placed where the grown finger wraps it in
     /// this pose (see [`super::compose::placement`]).
     pub arm_q0: [f64; 6],
@@ -24,6 +28,7 @@ impl Default for SceneSpec {
             physics: PhysicsConfig::default(),
             finger: FingerConfig::default(),
             object: Some(ObjectConfig::default()),
+            extra_pads_m: Vec::new(),
             arm_q0: ur5e::HOME,
         }
     }

@@ -37,12 +37,22 @@ pub struct Piece {
 /// pad casing and the tip anchor as single pieces, and grid points closer than half a link to a
 /// piece's edge dropped (no slivers).
 pub fn layout(f: &FingerConfig) -> Vec<Piece> {
+    layout_with_pads(f, &[])
+}
+
+/// As [`layout`], with the casings of further pads centred at `extra_pads_m` \[m of arc\] as rigid
+/// pieces too (a sensor array, `[array]`). Each further pad's casing is cut out of the grid as pad
+/// 0's is; the finer base stretch still ends at pad 0's casing.
+pub fn layout_with_pads(f: &FingerConfig, extra_pads_m: &[f64]) -> Vec<Piece> {
     let l = f.segment_length_m();
     let length = f.length_m;
-    let pad = (f.pad_position_m - PAD_HALF_LENGTH_M, f.pad_position_m + PAD_HALF_LENGTH_M);
+    let casing = |centre: f64| (centre - PAD_HALF_LENGTH_M, centre + PAD_HALF_LENGTH_M);
+    let pad = casing(f.pad_position_m);
+    let pads: Vec<(f64, f64)> = std::iter::once(pad).chain(extra_pads_m.iter().map(|&c| casing(c))).collect();
     let tip = length - TIP_LENGTH_M.min(length / 4.0);
-    let edges = [pad.0, pad.1, tip];
-    let inside_fixed = |s: f64| (s > pad.0 && s < pad.1) || s > tip;
+    let mut edges: Vec<f64> = pads.iter().flat_map(|&(a, b)| [a, b]).collect();
+    edges.push(tip);
+    let inside_fixed = |s: f64| pads.iter().any(|&(a, b)| s > a && s < b) || s > tip;
     // The base stretch (up to the pad's casing) on its finer grid, the rest on the uniform one; a
     // grid point closer than half its own link to a fixed edge is dropped.
     let base_l = l / f64::from(f.base_refinement.max(1));
@@ -53,10 +63,15 @@ pub fn layout(f: &FingerConfig) -> Vec<Piece> {
         .filter(|&(s, h)| !inside_fixed(s) && edges.iter().all(|e| (s - e).abs() >= h / 2.0 - 1e-12))
         .map(|(s, _)| s)
         .collect();
-    cuts.extend(edges);
+    // Two casings end to end share an edge: one cut.
+    for e in edges {
+        if !cuts.iter().any(|c| (c - e).abs() < 1e-12) {
+            cuts.push(e);
+        }
+    }
     cuts.push(0.0);
     cuts.sort_by(f64::total_cmp);
-    let fixed = |start: f64| (start - pad.0).abs() < 1e-12 || (start - tip).abs() < 1e-12;
+    let fixed = |start: f64| pads.iter().any(|&(a, _)| (start - a).abs() < 1e-12) || (start - tip).abs() < 1e-12;
     let mut pieces: Vec<Piece> = cuts
         .iter()
         .enumerate()
@@ -71,6 +86,11 @@ pub fn layout(f: &FingerConfig) -> Vec<Piece> {
         pieces[k].joint_span_m = before + flex(&pieces[k]);
     }
     pieces
+}
+
+/// The piece that carries the pad centred at `centre_m` \[m of arc\] (its casing's piece).
+pub fn pad_piece(pieces: &[Piece], centre_m: f64) -> usize {
+    pieces.iter().position(|p| p.fixed && (p.start_m - (centre_m - PAD_HALF_LENGTH_M)).abs() < 1e-12).unwrap_or(0)
 }
 
 #[cfg(test)]
@@ -134,5 +154,20 @@ mod tests {
         assert_eq!(pieces.len(), 30);
         let uniform = layout(&FingerConfig { segments: 64, base_refinement: 1, ..f });
         assert_eq!(uniform.len(), 55);
+    }
+
+    #[test]
+    fn further_pads_are_rigid_pieces_and_pad_zeros_layout_is_unchanged_without_them() {
+        let f = FingerConfig::default();
+        assert_eq!(layout_with_pads(&f, &[]), layout(&f));
+        let pieces = layout_with_pads(&f, &[0.03, 0.09]);
+        for centre in [f.pad_position_m, 0.03, 0.09] {
+            let p = pieces[pad_piece(&pieces, centre)];
+            assert!(p.fixed && (p.length_m - 2.0 * PAD_HALF_LENGTH_M).abs() < 1e-12, "{centre}: {p:?}");
+        }
+        assert_eq!(pieces.iter().filter(|p| p.fixed).count(), 4);
+        let total: f64 = pieces.iter().map(|p| p.length_m).sum();
+        assert!((total - f.length_m).abs() < 1e-12);
+        assert!(pieces.iter().all(|p| p.length_m > 1e-4), "no slivers: {pieces:?}");
     }
 }

@@ -8,6 +8,7 @@ use crate::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::{Pose, Vector};
 use std::sync::Arc;
+use tendril_fbg::array::PerPad;
 
 /// One rapier simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give the
 /// same trajectory (rapier is single-threaded here).
@@ -140,6 +141,10 @@ impl Physics for RapierScene {
         let ids = self.shared.ids();
         let w = &self.world;
         let (pad_force_n, _) = w.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
+        let mut extra_pad_forces_n = PerPad::filled(ids.extra_pad_geoms.len(), 0.0);
+        for (f, geoms) in extra_pad_forces_n.as_mut_slice().iter_mut().zip(&ids.extra_pad_geoms) {
+            *f = w.normal_force_between(geoms, &ids.object_geoms).0;
+        }
         let (grip_force_n, grip_contacts) = w.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
         let (palm_force_n, _) = w.normal_force_between(&ids.palm_geom, &ids.object_geoms);
         let hand_pose = w.body_pose(ids.hand_body);
@@ -147,6 +152,7 @@ impl Physics for RapierScene {
         let mut r = PhysicsReadout {
             time_s: w.time(),
             pad_force_n,
+            extra_pad_forces_n,
             grip_force_n,
             palm_force_n,
             grip_contacts,
