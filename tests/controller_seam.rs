@@ -106,7 +106,7 @@ fn plan(feedback: bool) -> ControlPlan {
         gripper: GripperConfig::default(),
         slip: SlipConfig::default(),
         object_weight_n: None,
-        array_control: Default::default(),
+        array: Default::default(),
     }
 }
 

@@ -124,3 +124,45 @@ fn the_shipped_array_scenario_loads_and_reads_three_pads() {
     // With `control = "first"` the controller regulates pad 0's estimate.
     assert!(rows.iter().all(|r| r[at("control_force_n")] == r[at("force_n")]));
 }
+
+/// `tendril run` of the crimper with `scenarios/hammer-array.toml`'s layout (a low pad where the
+/// wrap starts, one beyond pad 0) and `sets`; returns the summary.
+fn crimper_with_array(sets: &[&str], out: &Path) -> serde_json::Value {
+    let mut args = vec![
+        "scenarios/crimper.toml",
+        "--set",
+        "array.pads=[{arc_m=0.012,lambda1_nm=1525.0,protrusion_m=0.0025},{arc_m=0.0775,lambda1_nm=1560.0}]",
+    ];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    run(&args, out);
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+/// The array's slip cue sees the knocked crimper's drop before it happens (seed 1: 0.16 s before,
+/// docs/studies/placement.md), and stays silent through a run that holds.
+#[test]
+fn the_array_cue_fires_before_a_knocked_drop_and_not_in_a_held_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let knocked = crimper_with_array(
+        &[
+            "task.minimum_durations=false",
+            "disturbance.push.impulse_n_s=0.3",
+            "disturbance.push.duration_s=0.02",
+            "disturbance.push.phase=\"transfer\"",
+            "disturbance.push.offset_s=1.0",
+        ],
+        &dir.path().join("knocked"),
+    );
+    assert_eq!(knocked["outcome"], "dropped");
+    let delay = knocked["array"]["cue_detection_delay_s"].as_f64().expect("the cue saw the drop");
+    assert!(delay < 0.0, "the cue came {delay} s after the drop");
+    let held = crimper_with_array(&[], &dir.path().join("held"));
+    assert_eq!(held["outcome"], "held");
+    assert_eq!(held["array"]["cue_alarms"], 0, "{}", held["array"]);
+    assert_eq!(held["array"]["pads"].as_array().unwrap().len(), 3);
+    // The low pad where the wrap starts reads the crimper's wrap (0.4 N mean while holding).
+    let base = held["array"]["pads"][1]["mean_true_n"].as_f64().unwrap();
+    assert!(base > 0.1, "pad 1 carried {base} N");
+}

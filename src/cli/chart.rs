@@ -12,10 +12,11 @@ pub struct ChartArgs {
     /// Which study: `convergence` (exits 1 when a convergence criterion breaks), `speed-accuracy`,
     /// `stability`, `gain-map`, `controllers` (each force controller under disturbances) or
     /// `jitter` (the real path against the virtual devices under injected timing jitter, in real
-    /// time: about 14 s a run).
-    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter"])]
+    /// time: about 14 s a run) or `placement` (FBG sensor layouts along the finger; prints the
+    /// layout its numbers recommend).
+    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter", "placement"])]
     study: String,
-    /// Scenario to study [default: convergence, gain-map and controllers the three objects; speed-accuracy the crimper (its fine reference drops it too, so
+    /// Scenario to study [default: convergence, gain-map, controllers and placement the three objects; speed-accuracy the crimper (its fine reference drops it too, so
     /// drop times compare), stability the hammer (the heaviest load)].
     #[arg(long)]
     scenario: Vec<PathBuf>,
@@ -29,7 +30,7 @@ pub struct ChartArgs {
     /// side by side do not slow each other's figures (beyond shared caches).
     #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
-    /// Convergence, controllers and jitter: the seeds of every case [default: convergence 1,2,3;
+    /// Convergence, controllers, jitter and placement: the seeds of every case [default: convergence 1,2,3; placement 1-10, with --quick 1;
     /// controllers 1-10, with --quick 1,2; jitter 1,2, with --quick 1].
     #[arg(long, value_delimiter = ',')]
     seeds: Vec<u64>,
@@ -84,6 +85,12 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             study::gain_map::run(&scenarios, kp, ki, &out, a.threads)?
         }
         "controllers" => controllers(&a, &out)?,
+        "placement" => {
+            let plan = study::placement::Plan::new(objects_or(&a.scenario), a.quick, &a.seeds);
+            let outcome = study::placement::run(&plan, &out, a.threads)?;
+            emit(&format!("{}\n", outcome.recommendation));
+            outcome.files
+        }
         "jitter" => {
             let seeds = if a.seeds.is_empty() { if a.quick { vec![1] } else { vec![1, 2] } } else { a.seeds.clone() };
             study::jitter::run(&first("scenarios/short-lift.toml"), &study::jitter::cases(a.quick), &seeds, &out)?

@@ -23,6 +23,7 @@ const SWITCHED_ON: &[&str] = &[
     "[controller]\ntype = \"slip_margin\"\n",
     "[disturbance.push]\nimpulse_n_s = 0.3\nphase = \"lift\"\n[disturbance.dropout]\nduration_s = 0.5\nphase = \"lift\"\n",
     "[object]\nname = \"crimper\"\nfriction = 1.0\nposition_m = [0.0, 0.0]\nmass_kg = 0.1\nyaw_deg = 0.0\n",
+    "[array]\n[[array.pads]]\narc_m = 0.012\nlambda1_nm = 1525.0\nlambda2_nm = 1535.0\n",
 ];
 
 /// One key of the reference.
@@ -185,6 +186,13 @@ fn leaf(section: &str, key: &str, field: &Field, values: Option<String>) -> Row 
         "required".to_string()
     } else if field.ty.contains("PathBuf") {
         "see meaning".to_string()
+    } else if field.ty.starts_with("Vec<")
+        && field.ty[4..].starts_with(char::is_uppercase)
+        && !field.ty.contains("String")
+    {
+        // A list of tables (`[[array.pads]]`): empty unless given; a switched-on section's
+        // example entries are not its default.
+        "`[]`".to_string()
     } else {
         String::new()
     };

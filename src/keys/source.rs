@@ -20,6 +20,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("crates/fbg/src/estimate.rs", include_str!("../../crates/fbg/src/estimate.rs")),
     ("crates/fbg/src/hysteresis.rs", include_str!("../../crates/fbg/src/hysteresis.rs")),
     ("crates/fbg/src/config.rs", include_str!("../../crates/fbg/src/config.rs")),
+    ("crates/fbg/src/array.rs", include_str!("../../crates/fbg/src/array.rs")),
     ("crates/twin/src/sim.rs", include_str!("../../crates/twin/src/sim.rs")),
     ("crates/twin/src/wrist.rs", include_str!("../../crates/twin/src/wrist.rs")),
     ("crates/twin/src/disturbance.rs", include_str!("../../crates/twin/src/disturbance.rs")),

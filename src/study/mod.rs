@@ -16,6 +16,7 @@ pub mod controllers;
 pub mod convergence;
 pub mod gain_map;
 pub mod jitter;
+pub mod placement;
 pub mod speed_accuracy;
 pub mod stability;
 

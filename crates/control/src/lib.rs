@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+pub mod array_cue;
 pub mod config;
 pub mod contact;
 pub mod controller;

@@ -81,6 +81,12 @@ pub struct ArrayPad {
     /// reference grating reads the finger's temperature, which is one along the strip).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lambda2_nm: Option<f64>,
+    /// Height of its bump's tip above the strip's inner face \[m\]; absent: pad 0's
+    /// (`finger.pad_protrusion_m`, 5.5 mm: the paper's 4 mm casing and 1.5 mm bump). A lower pad
+    /// (a thinner casing, recessed into the sleeve) takes less of the wrap's load from its
+    /// neighbours (docs/guide/array.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub protrusion_m: Option<f64>,
 }
 
 fn first_channel() -> usize {
@@ -92,7 +98,9 @@ fn first_channel() -> usize {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ArrayConfig {
-    /// The further pads, base to tip or in any order (at most [`MAX_EXTRA_PADS`]).
+    /// The further pads, base to tip or in any order (at most [`MAX_EXTRA_PADS`]), each a table
+    /// with `arc_m`, `lambda1_nm` and optionally `channel`, `lambda2_nm`, `protrusion_m`
+    /// (`ArrayPad`).
     pub pads: Vec<ArrayPad>,
     /// What the controller regulates: `"first"` (pad 0), `"total"` or `"max"`.
     pub control: ArraySignal,
@@ -105,6 +113,20 @@ pub struct ArrayConfig {
     /// width at half maximum (`interrogator.spectral.fwhm_nm`, paper: 0.6-0.7 nm). Closer, the two
     /// lines' halves overlap and a centroid detector at half height sees one peak between them.
     pub guard_nm: f64,
+    /// The array's slip cue (`tendril_control::array_cue`): an alarm when this fraction of the
+    /// pads' load has moved from pad to pad against its slow average [-]. 0.3, a stated choice
+    /// (about a third of the load moved): with it the cue stays silent in every held run of the
+    /// placement study and sees the knocked crimpers' drops (docs/studies/placement.md).
+    pub cue_transfer: f64,
+    /// Time constant of the shares' slow average \[s\]: 1 s, the time the lift takes to bring the
+    /// object's weight on (its acceleration ramp), so that drift is followed and a knock is not.
+    pub cue_tau_s: f64,
+    /// Least load on the pads together for the cue to watch \[N\]: 0.2 N, about thirty times one
+    /// sample's noise (3 pm over 527 pm/N, paper Sec. IV-B); below it no distribution is known.
+    pub cue_min_load_n: f64,
+    /// Acting on the cue: from its first alarm in a carry the setpoint is multiplied by this
+    /// factor for the rest of the run [-]; 1: the cue only reports (the default).
+    pub retighten_factor: f64,
 }
 
 impl Default for ArrayConfig {
@@ -115,6 +137,10 @@ impl Default for ArrayConfig {
             min_temperature_c: 15.0,
             max_temperature_c: 45.0,
             guard_nm: 0.65,
+            cue_transfer: 0.3,
+            cue_tau_s: 1.0,
+            cue_min_load_n: 0.2,
+            retighten_factor: 1.0,
         }
     }
 }
@@ -133,12 +159,28 @@ impl Validate for ArrayConfig {
             if let Some(l2) = p.lambda2_nm {
                 at.in_range(&format!("pads[{i}].lambda2_nm"), l2, BAND_MIN_NM, BAND_MAX_NM);
             }
+            if let Some(h) = p.protrusion_m {
+                // As finger.pad_protrusion_m: from a bump just proud of the face to the casing and
+                // bump standing on it.
+                at.in_range(&format!("pads[{i}].protrusion_m"), h, 0.0005, 0.0055);
+            }
         }
         at.finite("min_temperature_c", self.min_temperature_c);
         at.require("max_temperature_c", self.max_temperature_c >= self.min_temperature_c, || {
             format!("must not be below min_temperature_c ({})", self.min_temperature_c)
         });
         at.in_range("guard_nm", self.guard_nm, 0.0, 10.0);
+        // A transfer is a fraction of the load (at most 1); 0 would alarm on every tick's noise.
+        at.require("cue_transfer", self.cue_transfer > 0.0 && self.cue_transfer <= 1.0, || {
+            format!("must be > 0 and at most 1, got {}", self.cue_transfer)
+        });
+        // 60 s: longer than any carry of the task, beyond which the average never moves.
+        at.in_range("cue_tau_s", self.cue_tau_s, 0.0, 60.0);
+        // Up to the range of all eight pads together (8 × 4.69 N).
+        at.in_range("cue_min_load_n", self.cue_min_load_n, 0.0, 8.0 * 4.69);
+        // At most 3×: a setpoint above the sensor's range is refused anyway, and the grip's
+        // force grows with it (docs/guide/array.md).
+        at.in_range("retighten_factor", self.retighten_factor, 1.0, 3.0);
     }
 }
 
@@ -169,6 +211,12 @@ pub struct GratingWindow {
 }
 
 impl ArrayConfig {
+    /// Whether this is the default section (no further pad, every setting at its default): what a
+    /// scenario without `[array]` has, and what a recorded scenario leaves out.
+    pub fn is_default(&self) -> bool {
+        *self == ArrayConfig::default()
+    }
+
     /// Whether the layout is the paper's single pad.
     pub fn is_single(&self) -> bool {
         self.pads.is_empty()
@@ -330,7 +378,7 @@ mod tests {
     use super::*;
 
     fn pad(arc_m: f64, lambda1_nm: f64) -> ArrayPad {
-        ArrayPad { arc_m, channel: 1, lambda1_nm, lambda2_nm: None }
+        ArrayPad { arc_m, channel: 1, lambda1_nm, lambda2_nm: None, protrusion_m: None }
     }
 
     #[test]

@@ -32,7 +32,7 @@ pub enum PlotError {
     /// The path holds none of the files `tendril plot` knows.
     #[error(
         "{0}: no trace.csv, results.csv, speed_accuracy.csv, convergence.csv, stability.csv, gain_map.csv, \
-         controllers.csv or jitter.csv here"
+         controllers.csv, jitter.csv or placement_summary.csv here"
     )]
     NothingToPlot(String),
     /// Drawing failed (plotters backend error).

@@ -14,6 +14,7 @@ pub mod gain_map;
 pub mod grid;
 pub mod input;
 pub mod jitter;
+pub mod placement;
 pub mod speed_accuracy;
 pub mod stability;
 pub mod style;

@@ -1,14 +1,14 @@
 //! `tendril plot PATH`: every chart a run, sweep or study folder (or one of its files) holds.
 
 use super::error::PlotError;
-use super::{controllers, convergence, gain_map, jitter, speed_accuracy, stability, sweep, trace};
+use super::{controllers, convergence, gain_map, jitter, placement, speed_accuracy, stability, sweep, trace};
 use std::path::{Path, PathBuf};
 
 /// `tendril plot PATH [--out DIR]`: draws every chart the path holds and returns the files written.
 ///
 /// PATH is a run directory (`trace.csv`, optional `summary.json`), a sweep directory
 /// (`results.csv`), a directory holding any of `speed_accuracy.csv`, `stability.csv`,
-/// `gain_map.csv`, `controllers.csv`, `jitter.csv`, or one of those files. Charts go to `out` (default: the directory of the input).
+/// `gain_map.csv`, `controllers.csv`, `jitter.csv`, `placement_summary.csv`, or one of those files. Charts go to `out` (default: the directory of the input).
 pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotError> {
     let (dir, only) = if path.is_file() {
         (
@@ -49,6 +49,9 @@ pub fn plot_path(path: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>, PlotEr
     }
     if wanted("controllers.csv") {
         written.extend(controllers::render(&controllers::read(&dir.join("controllers.csv"))?, &out_dir)?);
+    }
+    if wanted("placement_summary.csv") {
+        written.extend(placement::render(&placement::read(&dir.join("placement_summary.csv"))?, &out_dir)?);
     }
     if written.is_empty() {
         return Err(PlotError::NothingToPlot(path.display().to_string()));

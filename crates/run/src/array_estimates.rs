@@ -15,6 +15,8 @@ struct PadEstimator {
     estimator: ForceEstimator,
     tare: TareAverager,
     invalid: InvalidSamples,
+    /// The estimate of the tare itself \[N\]: what the pad reads unloaded (eq. 8's intercept).
+    unloaded_n: f64,
 }
 
 /// The further pads' estimators (none without an array).
@@ -33,6 +35,7 @@ impl ArrayEstimates {
                     estimator: ForceEstimator::new(calibration.clone()),
                     tare: TareAverager::default(),
                     invalid: InvalidSamples::default(),
+                    unloaded_n: 0.0,
                 })
                 .collect();
         }
@@ -45,7 +48,9 @@ impl ArrayEstimates {
             if w.fbg1_nm.is_finite() && w.fbg2_nm.is_finite() {
                 pad.tare.add(*w);
             }
-            pad.estimator.tare(pad.tare.mean());
+            let mean = pad.tare.mean();
+            pad.estimator.tare(mean);
+            pad.unloaded_n = pad.estimator.estimate(mean).map_or(0.0, |e| e.force_n);
         }
     }
 
@@ -68,6 +73,11 @@ impl ArrayEstimates {
             out.as_mut_slice()[k] = estimate.force_n;
         }
         Ok(out)
+    }
+
+    /// Each further pad's unloaded reading \[N\] (0 before the tare).
+    pub(crate) fn unloaded_n(&self, k: usize) -> f64 {
+        self.pads.get(k).map_or(0.0, |p| p.unloaded_n)
     }
 
     /// Invalid samples over the run, all further pads together.

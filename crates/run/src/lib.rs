@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 mod array_estimates;
+pub mod array_summary;
 mod backend_defaults;
 pub mod clock;
 pub mod compare;

@@ -4,7 +4,7 @@ use tendril_cell::gripper::GripperConfig;
 use tendril_control::ControllerConfig;
 use tendril_control::slip::SlipConfig;
 use tendril_control::task::TaskConfig;
-use tendril_fbg::array::ArraySignal;
+use tendril_fbg::array::ArrayConfig;
 use tendril_fbg::estimate::ForceCalibration;
 
 /// Everything the control side needs for one run (the cell is configured separately).
@@ -29,7 +29,7 @@ pub struct ControlPlan {
     /// The object's weight \[N\], when known (its mass from the scenario): what the wrist must read
     /// once the lift is under way ([`tendril_control::slip::SlipDetector::with_object_weight`]).
     pub object_weight_n: Option<f64>,
-    /// What the controller regulates when the cell reads a sensor array (`array.control`): pad 0's
-    /// estimate (the paper's), the pads' total or their largest.
-    pub array_control: ArraySignal,
+    /// The sensor array (`[array]`): what the controller regulates over its pads (`control`),
+    /// the slip cue's thresholds and whether the run acts on it. Empty: the paper's single pad.
+    pub array: ArrayConfig,
 }

@@ -57,6 +57,8 @@ pub struct RunReport {
     pub rows: Vec<TraceRow>,
     /// How the device streams kept up (a real cell).
     pub device_timing: Option<tendril_cell::DeviceTiming>,
+    /// A sensor array's figures and slip cue (`None` with the paper's single pad).
+    pub array: Option<super::array_summary::ArraySummary>,
 }
 
 /// Consecutive invalid sensor samples (no estimate: non-finite, or below the calibration curve)

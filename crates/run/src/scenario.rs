@@ -21,7 +21,7 @@ use tendril_fbg::array::ArrayConfig;
 use tendril_fbg::estimate::ForceCalibration;
 use tendril_fbg::{InterrogatorConfig, InterrogatorMode, SensorConfig};
 use tendril_twin::disturbance::DisturbanceConfig;
-use tendril_twin::physics::{FingerConfig, ObjectConfig, PhysicsConfig, SceneModel, SceneSpec};
+use tendril_twin::physics::{FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, SceneModel, SceneSpec};
 use tendril_twin::sim::{EnvironmentConfig, SimCell};
 use tendril_twin::wrist::WristConfig;
 
@@ -72,8 +72,8 @@ pub struct PickPlaceScenario {
     #[serde(default)]
     pub interrogator: InterrogatorConfig,
     /// Further FBG pads along the finger (a sensor array) and what the controller regulates over
-    /// them; none by default: the paper's single pad (docs/cell/array.md).
-    #[serde(default, skip_serializing_if = "ArrayConfig::is_single")]
+    /// them; none by default: the paper's single pad (docs/guide/array.md).
+    #[serde(default, skip_serializing_if = "ArrayConfig::is_default")]
     pub array: ArrayConfig,
     /// Temperature at the sensor.
     #[serde(default)]
@@ -167,8 +167,11 @@ impl Validate for PickPlaceScenario {
             format!("must not exceed finger.length_m ({} m)", self.finger.length_m)
         });
         self.check_gratings_in_windows(at);
-        at.section("array", &self.array);
-        self.check_array(at);
+        // The default layout (no further pad, every threshold at its default) has nothing to check.
+        if self.array != ArrayConfig::default() {
+            at.section("array", &self.array);
+            self.check_array(at);
+        }
     }
 }
 
@@ -249,7 +252,15 @@ impl PickPlaceScenario {
             physics: self.physics.clone(),
             finger: self.finger.clone(),
             object: Some(self.object.clone()),
-            extra_pads_m: self.array.pads.iter().map(|p| p.arc_m).collect(),
+            extra_pads: self
+                .array
+                .pads
+                .iter()
+                .map(|p| PadPlace {
+                    arc_m: p.arc_m,
+                    protrusion_m: p.protrusion_m.unwrap_or(self.finger.pad_protrusion_m),
+                })
+                .collect(),
             arm_q0: self.task.home_deg.map(f64::to_radians),
         }
     }
@@ -292,7 +303,7 @@ impl PickPlaceScenario {
             gripper: self.gripper,
             slip: self.slip,
             object_weight_n: Some(self.object_mass_kg() * tendril_cell::G_M_S2).filter(|w| w.is_finite()),
-            array_control: self.array.control,
+            array: self.array.clone(),
         }
     }
 }

@@ -24,6 +24,7 @@ use super::report::{Drop, Outcome, RunReport};
 use super::samples::{InvalidSamples, TareAverager};
 use super::trace::{ArrayRow, PadRow, TraceRow, TraceWriter};
 use tendril_cell::{Cell, CellError, CellState, GroundTruth, Phase, Wavelengths};
+use tendril_control::array_cue::ArrayCue;
 use tendril_control::controller::ForceController;
 use tendril_control::slip::{ArmReading, SlipDetector, judge};
 use tendril_control::task::{ControlAction, TaskSequencer};
@@ -91,6 +92,10 @@ pub struct Session<C: Cell> {
     estimator: ForceEstimator,
     tare: TareAverager,
     array: ArrayEstimates,
+    /// The array's slip cue (watches nothing without an array).
+    cue: ArrayCue,
+    /// When the run acted on the cue (`array.retighten_factor`), cell time \[s\].
+    retightened_s: Option<f64>,
     unloaded_n: f64,
     invalid: InvalidSamples,
     slip: SlipDetector,
@@ -132,6 +137,8 @@ impl<C: Cell> Session<C> {
             sequencer,
             tare: TareAverager::default(),
             array: ArrayEstimates::default(),
+            cue: ArrayCue::new(plan.array.cue_transfer, plan.array.cue_tau_s, plan.array.cue_min_load_n),
+            retightened_s: None,
             unloaded_n: 0.0,
             invalid: InvalidSamples::default(),
             slip,
@@ -308,7 +315,7 @@ impl<C: Cell> Session<C> {
             let mut all = [0.0; MAX_PADS];
             all[0] = estimate.force_n;
             all[1..=array.len()].copy_from_slice(array.as_slice());
-            self.plan.array_control.of(&all[..=array.len()])
+            self.plan.array.control.of(&all[..=array.len()])
         };
         Ok(Pending { state, estimate, array, control_force_n })
     }
@@ -316,8 +323,12 @@ impl<C: Cell> Session<C> {
     /// Sequences and controls on a reading, writes the command, records the tick.
     fn act(&mut self, p: Pending, action: Action) -> Result<TraceRow, CellError> {
         let (state, estimate, force_n) = (p.state, p.estimate, p.control_force_n);
+        self.watch_array(&state, &estimate, &p.array);
         let control = match action {
-            Action::Controller => ControlAction::Controller,
+            Action::Controller => match self.retightened_s {
+                Some(_) => ControlAction::Setpoint(self.plan.setpoint_n * self.plan.array.retighten_factor),
+                None => ControlAction::Controller,
+            },
             Action::TwineSpeed(deg_s) => ControlAction::TwineSpeed(deg_s),
             Action::Setpoint(n) => ControlAction::Setpoint(n),
         };
@@ -370,6 +381,27 @@ impl<C: Cell> Session<C> {
         Ok(row)
     }
 
+    /// The array's slip cue on this tick's loads (each pad's estimate above its unloaded
+    /// reading), watching while the arm carries the object; its first alarm re-tightens the grip
+    /// when the scenario asks (`array.retighten_factor` > 1).
+    fn watch_array(&mut self, state: &CellState, estimate: &Estimate, array: &PerPad<f64>) {
+        if array.is_empty() {
+            return;
+        }
+        let mut loads = [0.0; MAX_PADS];
+        loads[0] = estimate.force_n - self.unloaded_n;
+        for (k, f) in array.as_slice().iter().enumerate() {
+            loads[k + 1] = f - self.array.unloaded_n(k);
+        }
+        let watching = self.sequencer.phase().arm_moving();
+        if self.cue.update(state.time_s, &loads[..=array.len()], watching)
+            && self.retightened_s.is_none()
+            && self.plan.array.retighten_factor > 1.0
+        {
+            self.retightened_s = Some(state.time_s);
+        }
+    }
+
     /// Ends the run: the cell deactivated whatever happened (and the trace flushed), the run
     /// judged. Returns the report and the trace writer (whose write errors the caller reports).
     pub fn finish(mut self) -> (RunReport, Option<TraceWriter>) {
@@ -392,6 +424,16 @@ impl<C: Cell> Session<C> {
             (None, None) => Outcome::Held,
         };
         let metrics = control_metrics(&rows, drop.map(|d| d.cell_time_s));
+        let array = rows.first().filter(|r| !r.array.pads.is_empty()).map(|_| {
+            super::array_summary::summarise(
+                &rows,
+                self.cue.alarms_s(),
+                self.retightened_s,
+                drop.map(|d| d.cell_time_s),
+                self.sequencer.motion_start_s(),
+                self.plan.calibration.range_n,
+            )
+        });
         let report = RunReport {
             outcome,
             drop,
@@ -406,6 +448,7 @@ impl<C: Cell> Session<C> {
             dropped_samples: self.dropped_samples,
             rows,
             device_timing,
+            array,
         };
         (report, self.trace.take())
     }

@@ -107,6 +107,10 @@ pub struct RunSummary {
     /// how late the ticks were, against the watchdog's limits.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub device_timing: Option<tendril_cell::DeviceTiming>,
+    /// With a sensor array: each pad's figures and the array's slip cue (absent with the paper's
+    /// single pad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array: Option<super::array_summary::ArraySummary>,
     /// MuJoCo's warnings during the run (see [`tendril_twin::mujoco_log`]), at most
     /// [`tendril_twin::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
     #[serde(default)]
@@ -160,6 +164,7 @@ impl RunSummary {
             invalid_samples: report.invalid_samples,
             dropped_samples: report.dropped_samples,
             device_timing: report.device_timing,
+            array: report.array.clone(),
             warnings: Vec::new(),
         }
     }
@@ -221,6 +226,9 @@ pub fn render_text(s: &RunSummary) -> String {
         out += &format!("    outside the push  {}\n", opt(s.metrics.max_fluctuation_outside_push_pct, "%"));
     }
     out += &format!("  estimate RMSE      {}\n", opt(s.metrics.force_rmse_n, "N"));
+    if let Some(a) = &s.array {
+        out += &render_array(a);
+    }
     out += &format!(
         "  simulated {:.1} s in {:.2} s wall ({}x real time), {:.2} s of CPU ({}x)\n",
         s.sim_time_s,
@@ -230,6 +238,36 @@ pub fn render_text(s: &RunSummary) -> String {
         speed_factor(s.sim_s_per_cpu_s)
     );
     out
+}
+
+/// The array's lines of the text summary: each pad's forces, and the slip cue.
+fn render_array(a: &super::array_summary::ArraySummary) -> String {
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2}"));
+    let mut out = String::new();
+    for p in &a.pads {
+        out += &format!(
+            "  pad {}              true {} N, peak {} N, RMSE {} N while holding",
+            p.pad,
+            opt(p.mean_true_n),
+            opt(p.peak_n),
+            opt(p.estimate_rmse_n)
+        );
+        if let Some(over) = p.over_range_pct.filter(|&o| o > 0.0) {
+            out += &format!("; over range {over:.0} % of it");
+        }
+        out += "\n";
+    }
+    out += &format!("  array cue          {} alarm(s)", a.cue_alarms);
+    if let Some(d) = a.cue_detection_delay_s {
+        out += &format!("; saw the drop {:.2} s {}", d.abs(), if d < 0.0 { "before it" } else { "after it" });
+    }
+    if let Some(n) = a.cue_false_alarms.filter(|&n| n > 0) {
+        out += &format!("; {n} false");
+    }
+    if let Some(t) = a.retightened_s {
+        out += &format!("; re-tightened {t:.2} s after the arm started moving");
+    }
+    out + "\n"
 }
 
 /// A speed ratio (simulated s per s) to two significant figures, so that a slow backend's 0.35x

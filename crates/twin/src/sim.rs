@@ -104,7 +104,7 @@ fn pad_seed(seed: u64, k: usize) -> u64 {
 impl SimCell {
     /// Reads the further pads of `array` besides pad 0 (`[array]`): each its own sensor model
     /// (`sensor` with the pad's wavelengths) and noise stream, sampled at pad 0's instants with
-    /// its own contact force. The scene must carry the same pads (`SceneSpec::extra_pads_m`);
+    /// its own contact force. The scene must carry the same pads (`SceneSpec::extra_pads`);
     /// [`Cell::configure`] refuses it otherwise.
     pub fn with_array(mut self, array: &ArrayConfig) -> SimCell {
         self.array = (1..=array.pads.len())
@@ -332,7 +332,7 @@ impl Cell for SimCell {
         for (k, pad) in self.array.iter_mut().enumerate() {
             pad.model = FbgSensor::new(&pad.config, &self.interrogator, pad_seed(self.seed, k + 1));
         }
-        let pads_in_scene = self.model.spec().extra_pads_m.len();
+        let pads_in_scene = self.model.spec().extra_pads.len();
         if pads_in_scene != self.array.len() {
             return Err(CellError::Configure(format!(
                 "the sensor array reads {} further pads, the scene carries {pads_in_scene}",

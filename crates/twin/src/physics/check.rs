@@ -92,7 +92,7 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
         physics: s.physics.clone(),
         finger: s.finger.clone(),
         object: Some(s.object.clone()),
-        extra_pads_m: Vec::new(),
+        extra_pads: Vec::new(),
         arm_q0: ur5e::HOME,
     };
     let mut scene = SceneModel::build(&spec)?.start()?;

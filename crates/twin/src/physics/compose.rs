@@ -3,7 +3,7 @@
 use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig, Solver};
 use super::object::ObjectModel;
 use super::template::{num, nums, render, section};
-use super::{PhysicsError, SceneSpec};
+use super::{PadPlace, PhysicsError, SceneSpec};
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::path::Path;
 use tendril_ur5e::kinematics as ur5e;
@@ -116,17 +116,17 @@ pub fn header(p: &PhysicsConfig) -> String {
 
 /// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
 /// document whose hand body goes into the arm's flange.
-/// With `extra_pads_m`, further sensor pads (a sensor array) sit on the strip at those arcs, each
-/// a copy of `sensor_pad.xml` whose names carry its number (`pad1_casing`, ...).
-pub fn finger(f: &FingerConfig, extra_pads_m: &[f64], models: Option<&Path>) -> Result<String, PhysicsError> {
+/// With `extra_pads`, further sensor pads (a sensor array) sit on the strip, each a copy of
+/// `sensor_pad.xml` whose names carry its number (`pad1_casing`, ...).
+pub fn finger(f: &FingerConfig, extra_pads: &[PadPlace], models: Option<&Path>) -> Result<String, PhysicsError> {
     let (finger_text, segment_text, pad_text) =
         (part(models, "finger.xml")?, part(models, "finger_segment.xml")?, part(models, "sensor_pad.xml")?);
-    let pieces = super::strip::layout_with_pads(f, extra_pads_m);
+    let pieces = super::strip::layout_with_pads(f, &PadPlace::arcs(extra_pads));
     let r = f.thickness_m / 2.0;
-    // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
-    let sink = f.pad_protrusion_m - PAD_HEIGHT_M;
-    let pad_at = |centre: f64| -> Result<(usize, String), PhysicsError> {
+    let pad_at = |centre: f64, protrusion_m: f64| -> Result<(usize, String), PhysicsError> {
         let seg = super::strip::pad_piece(&pieces, centre);
+        // How far the pad sits lower than standing on the strip's face (<= 0: recessed into the sleeve).
+        let sink = protrusion_m - PAD_HEIGHT_M;
         let xml = render(
             body_of(&pad_text),
             &[
@@ -139,9 +139,9 @@ pub fn finger(f: &FingerConfig, extra_pads_m: &[f64], models: Option<&Path>) -> 
         )?;
         Ok((seg, xml))
     };
-    let mut pads = vec![pad_at(f.pad_position_m)?];
-    for (k, &centre) in extra_pads_m.iter().enumerate() {
-        let (seg, xml) = pad_at(centre)?;
+    let mut pads = vec![pad_at(f.pad_position_m, f.pad_protrusion_m)?];
+    for (k, p) in extra_pads.iter().enumerate() {
+        let (seg, xml) = pad_at(p.arc_m, p.protrusion_m)?;
         pads.push((seg, xml.replace("name=\"pad_", &format!("name=\"pad{}_", k + 1))));
     }
     let pads_on = |i: usize| pads.iter().filter(|(seg, _)| *seg == i).map(|(_, xml)| xml.as_str()).collect::<String>();
@@ -264,7 +264,7 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     }
     // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
     // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
-    let finger_doc = finger(&spec.finger, &spec.extra_pads_m, models)?;
+    let finger_doc = finger(&spec.finger, &spec.extra_pads, models)?;
     let arm = render(&part(models, "ur5e.xml")?, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
     worldbody.push_str(section(&arm, "worldbody"));
     if spec.physics.arm_mode == ArmMode::Dynamic {

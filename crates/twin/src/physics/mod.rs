@@ -42,4 +42,4 @@ pub use config::{
 pub use engine::Physics;
 pub use error::{Divergence, PhysicsError};
 pub use scene::{PhysicsReadout, Scene, SceneModel};
-pub use spec::SceneSpec;
+pub use spec::{PadPlace, SceneSpec};

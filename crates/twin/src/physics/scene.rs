@@ -5,7 +5,7 @@ use super::compose::{self, Placement};
 use super::config::{ArmMode, Backend};
 use super::drive::{Drive, grip_in_hand};
 use super::guide::GuidePruning;
-use super::{Divergence, Physics, PhysicsError, SceneSpec};
+use super::{Divergence, PadPlace, Physics, PhysicsError, SceneSpec};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtEnableBit, mjtState, mjtWarning};
 use mujoco_rs::prelude::{MjData, MjModel};
 use nalgebra::{Isometry3, Vector3};
@@ -39,7 +39,7 @@ pub struct SceneModel {
 pub(crate) struct Ids {
     /// Geoms of the sensor pad (casing, bump).
     pub(crate) pad_geoms: Vec<usize>,
-    /// Geoms of each further pad of a sensor array (`SceneSpec::extra_pads_m`).
+    /// Geoms of each further pad of a sensor array (`SceneSpec::extra_pads`).
     pub(crate) extra_pad_geoms: Vec<Vec<usize>>,
     /// Geoms of the strip and the pad.
     pub(crate) finger_geoms: Vec<usize>,
@@ -146,11 +146,11 @@ impl SceneModel {
         let act = |n: &str| id(m, mjOBJ_ACTUATOR, "actuator", n);
         let pad_geoms = vec![geom("pad_casing")?, geom("pad_bump")?];
         let mut finger_geoms = pad_geoms.clone();
-        let extra_pad_geoms = (1..=spec.extra_pads_m.len())
+        let extra_pad_geoms = (1..=spec.extra_pads.len())
             .map(|k| Ok(vec![geom(&format!("pad{k}_casing"))?, geom(&format!("pad{k}_bump"))?]))
             .collect::<Result<Vec<_>, PhysicsError>>()?;
         finger_geoms.extend(extra_pad_geoms.iter().flatten());
-        for i in 0..super::strip::layout_with_pads(&spec.finger, &spec.extra_pads_m).len() {
+        for i in 0..super::strip::layout_with_pads(&spec.finger, &PadPlace::arcs(&spec.extra_pads)).len() {
             finger_geoms.push(geom(&format!("seg{i}"))?);
         }
         let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() {

@@ -4,6 +4,22 @@ use super::config::{FingerConfig, ObjectConfig, PhysicsConfig};
 use tendril_config::{Checker, Validate};
 use tendril_ur5e::kinematics as ur5e;
 
+/// Where a further sensor pad sits on the strip.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PadPlace {
+    /// Its centre's distance from the strip's base \[m of arc\].
+    pub arc_m: f64,
+    /// Height of its bump's tip above the strip's inner face \[m\] (as `finger.pad_protrusion_m`).
+    pub protrusion_m: f64,
+}
+
+impl PadPlace {
+    /// The arcs of `pads` \[m\].
+    pub fn arcs(pads: &[PadPlace]) -> Vec<f64> {
+        pads.iter().map(|p| p.arc_m).collect()
+    }
+}
+
 /// What a scene holds and how it is simulated.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneSpec {
@@ -13,10 +29,10 @@ pub struct SceneSpec {
     pub finger: FingerConfig,
     /// The object (and with it the table); `None` for a finger-only scene.
     pub object: Option<ObjectConfig>,
-    /// Centres of further sensor pads along the strip \[m of arc\] (a sensor array, `[array]`);
-    /// empty: the paper's single pad at `finger.pad_position_m`. Each is a pad like pad 0, named
-    /// `pad{k}_casing`, `pad{k}_bump`, `pad{k}_site` (k = 1, 2, ...).
-    pub extra_pads_m: Vec<f64>,
+    /// Further sensor pads along the strip (a sensor array, `[array]`); empty: the paper's
+    /// single pad at `finger.pad_position_m`. Each is a pad like pad 0, named `pad{k}_casing`,
+    /// `pad{k}_bump`, `pad{k}_site` (k = 1, 2, ...).
+    pub extra_pads: Vec<PadPlace>,
     /// Start joint angles of the arm \[rad\]. The object is placed where the grown finger wraps it in
     /// this pose (see [`super::compose::placement`]).
     pub arm_q0: [f64; 6],
@@ -28,7 +44,7 @@ impl Default for SceneSpec {
             physics: PhysicsConfig::default(),
             finger: FingerConfig::default(),
             object: Some(ObjectConfig::default()),
-            extra_pads_m: Vec::new(),
+            extra_pads: Vec::new(),
             arm_q0: ur5e::HOME,
         }
     }
