@@ -58,7 +58,7 @@ impl FbgWindows {
                 return Ok(*self);
             }
             let reason = format!(
-                "windows for {} further pads, but the scenario has no [array] (its pads come first)",
+                "{} further pad(s)' windows given, but the scenario has no [array] to give the pads",
                 self.pads.len()
             );
             return Err(vec![("hardware.fbg.pads".into(), reason)]);
@@ -129,7 +129,7 @@ impl FbgWindows {
             faults.push((
                 "hardware.fbg.pads".to_string(),
                 format!(
-                    "windows for {} further pads, the layout has {} ([[array.pads]]): one per further pad, in its order",
+                    "{} further pad(s)' windows given, the layout has {} ([[array.pads]]): one per further pad, in its order",
                     given.len(),
                     array.pads.len()
                 ),
