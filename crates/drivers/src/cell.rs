@@ -118,7 +118,9 @@ pub struct RealCellConfig {
     pub command_port: u16,
     /// HYPERION peak stream port (51972).
     pub stream_port: u16,
-    /// Motor IDs, bus speed, FBG windows (the scenario's `[hardware]`).
+    /// Motor IDs, bus speed, FBG windows (the scenario's `[hardware]`; with a sensor array, every
+    /// pad's windows, as `tendril_run::real::hardware_for` resolves them: the cell reads as many
+    /// further pads as [`FbgWindows::pads`](tendril_hyperion::FbgWindows::pads) lists).
     pub hardware: HardwareConfig,
     /// Interrogator sample period \[s\] (1 kHz on the si255, docs/facts.md#hyperion-scan-rate).
     pub sensor_period_s: f64,

@@ -117,6 +117,14 @@ pub fn run_on_real_with(
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     // Disturbances are the twin's: refuse before any device is contacted.
     scenario.disturbance.refuse_on_real().map_err(|e| anyhow::anyhow!("{e}"))?;
+    // A configuration made by hand for a sensor array's scenario must read every pad, or the run
+    // would control on pad 0 alone without a word.
+    let (windows, pads) = (config.hardware.fbg.pads.len(), scenario.array.pads.len());
+    anyhow::ensure!(
+        windows == pads,
+        "the real cell's configuration has windows for {windows} further pad(s), the scenario's [array] has {pads}: \
+         make it with Devices::config or hardware_for"
+    );
     let started = super::clock::RunClock::start();
     let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator);
     let mut cell = LimitedCell::new(RealCell::new(config), limits);
