@@ -351,3 +351,44 @@ fn idle_command_connections_are_closed() {
     }
     serve.stop().unwrap();
 }
+
+/// A three-pad sensor array (`scenarios/hammer-array.toml`) on the real path: `serve` puts every
+/// grating on channel 1, the real cell maps each peak to its pad by the windows derived from the
+/// layout and reads all three pads, as the twin does; windows that miss a pad's peak stop the
+/// configure with the pad, grating, window and channel named.
+#[test]
+fn a_three_pad_array_is_served_and_read_on_every_pad() {
+    let _turn = one_at_a_time();
+    use tendril_cell::CellCommand;
+    use tendril_hyperion::PadWindowList;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/hammer-array.toml");
+    let scenario: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&path, &[]).unwrap();
+    let serve = start(&scenario, &ServeConfig::ephemeral()).unwrap();
+    let mut config = serve.real_cell_config();
+    assert_eq!(config.hardware.fbg.pads.len(), 2, "the further pads' windows, derived from [array]");
+    assert_eq!(config.hardware, tendril_run::real::hardware_for(&scenario).unwrap());
+    let mut cell = RealCell::new(config);
+    cell.configure().unwrap();
+    cell.activate().unwrap();
+    for k in 1..=20 {
+        let s = cell.read().unwrap();
+        let [one, two] = s.array.as_slice() else { panic!("two further pads: {:?}", s.array) };
+        // Unloaded at home: each strain grating near its wavelength, the shared reference pad 0's.
+        assert!((one.fbg1_nm - 1525.0).abs() < 0.5 && (two.fbg1_nm - 1560.0).abs() < 0.5, "{:?}", s.array);
+        assert!((s.wavelengths.fbg1_nm - 1540.0).abs() < 0.5, "{:?}", s.wavelengths);
+        assert_eq!((one.fbg2_nm, two.fbg2_nm), (s.wavelengths.fbg2_nm, s.wavelengths.fbg2_nm));
+        let c = CellCommand { arm_q: s.arm_q, growth_motor_rad: 0.0, twine_motor_rad: 0.0 };
+        cell.write(&c).unwrap();
+        cell.wait_until(k as f64 * 0.01).unwrap();
+    }
+    cell.deactivate().unwrap();
+    drop(cell);
+    // Pad 2's FBG1 window moved off its peak: no scan maps, and the error says which window.
+    config = serve.real_cell_config();
+    let mut pads = config.hardware.fbg.pads.as_slice().to_vec();
+    pads[1].fbg1_min_nm = 1570.0;
+    config.hardware.fbg.pads = PadWindowList::new(&pads).unwrap();
+    let err = RealCell::new(config).configure().unwrap_err().to_string();
+    assert!(err.contains("pad 2: no FBG1 peak in [1570.00, 1600.00) nm on channel 1"), "{err}");
+    serve.stop().unwrap();
+}

@@ -71,6 +71,16 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
         h.twine_id,
         h.dxl_baud
     ));
+    for (k, p) in h.fbg.pads.as_slice().iter().enumerate() {
+        emit(&format!(
+            "            pad {}: FBG1 in [{:.2}, {:.2}) nm{} on channel {}\n",
+            k + 1,
+            p.fbg1_min_nm,
+            p.fbg1_max_nm,
+            if p.fbg2().is_some() { ", its own FBG2" } else { ", pad 0's FBG2" },
+            p.channel
+        ));
+    }
     if let Some(j) = config.jitter {
         let link = j.only.map_or("every link".to_string(), |l| format!("{l:?}"));
         emit(&format!("  jitter    {:?} on {link}, seed {} (docs/cell/timing.md#injected-jitter)\n", a.jitter, j.seed));

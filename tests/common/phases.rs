@@ -16,11 +16,17 @@ pub fn from_report(report: &RunReport) -> Vec<Tick> {
 
 /// The ticks of a run's `trace.csv`.
 pub fn from_trace_csv(path: &std::path::Path) -> Vec<Tick> {
+    from_trace_csv_column(path, "force_n")
+}
+
+/// The ticks of a run's `trace.csv` with `column` as the force (`pad1_force_n`: a sensor array's
+/// further pad's estimate).
+pub fn from_trace_csv_column(path: &std::path::Path, column: &str) -> Vec<Tick> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     let col = |name: &str| header.iter().position(|c| *c == name).unwrap_or_else(|| panic!("no {name} column"));
-    let (phase, time, force) = (col("phase"), col("time_s"), col("force_n"));
+    let (phase, time, force) = (col("phase"), col("time_s"), col(column));
     lines
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();

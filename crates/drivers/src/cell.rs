@@ -34,6 +34,7 @@ use std::time::{Duration, Instant};
 use tendril_cell::{
     ARM_JOINTS, BLIND_TICKS, Cell, CellCommand, CellError, CellState, DeviceTiming, Lifecycle, Spread, require_state,
 };
+use tendril_fbg::array::ArrayPeaks;
 use tendril_fbg::signals::Wavelengths;
 use tendril_rtde::state::{ROBOT_MODE_RUNNING, RUNTIME_STATE_PLAYING, SAFETY_MODE_NORMAL};
 use tendril_urscript::FOLLOW_SCRIPT;
@@ -117,7 +118,9 @@ pub struct RealCellConfig {
     pub command_port: u16,
     /// HYPERION peak stream port (51972).
     pub stream_port: u16,
-    /// Motor IDs, bus speed, FBG windows (the scenario's `[hardware]`).
+    /// Motor IDs, bus speed, FBG windows (the scenario's `[hardware]`; with a sensor array, every
+    /// pad's windows, as `tendril_run::real::hardware_for` resolves them: the cell reads as many
+    /// further pads as [`FbgWindows::pads`](tendril_hyperion::FbgWindows::pads) lists).
     pub hardware: HardwareConfig,
     /// Interrogator sample period \[s\] (1 kHz on the si255, docs/facts.md#hyperion-scan-rate).
     pub sensor_period_s: f64,
@@ -190,6 +193,10 @@ struct Latest {
     arm: ArmSample,
     arm_age: Duration,
     wavelengths: Wavelengths,
+    /// The further pads' peaks (a sensor array's; empty without one).
+    array: ArrayPeaks,
+    /// Why the newest scans could not be mapped to the pads, if they could not.
+    unmapped: Option<String>,
     /// Scan serial number of the peak sample.
     serial: u64,
     sensor_age: Duration,
@@ -204,18 +211,21 @@ impl Devices {
     fn latest(&self) -> Result<Latest, CellError> {
         let (arm, arm_age) =
             self.ur.latest().map_err(|e| device("UR5e", e))?.ok_or_else(|| device("UR5e", "no data"))?;
-        let (wavelengths, sensor_at, serial) = {
+        let ((sample, sensor_at, serial), unmapped) = {
             let feed = self.peaks.lock().unwrap_or_else(|p| p.into_inner());
             if let Some(why) = &feed.closed {
                 return Err(device("HYPERION", why));
             }
-            feed.latest.ok_or_else(|| device("HYPERION", "no data"))?
+            let no_data = || device("HYPERION", feed.unmapped.as_deref().unwrap_or("no data"));
+            (feed.latest.ok_or_else(no_data)?, feed.unmapped.clone())
         };
         let motors = self.gripper.link()?.latest().map_err(|e| device("MX-106", e))?;
         Ok(Latest {
             arm,
             arm_age,
-            wavelengths,
+            wavelengths: sample.first,
+            array: sample.array,
+            unmapped,
             serial,
             sensor_age: sensor_at.elapsed(),
             motors_rad: motors.rad,
@@ -236,7 +246,12 @@ impl Watchdog {
         for (name, what, age, limit_s) in streams {
             if age.as_secs_f64() > limit_s {
                 let (age_ms, limit_ms) = (age.as_secs_f64() * 1e3, limit_s * 1e3);
-                return Err(device(name, format!("watchdog: last {what} {age_ms:.1} ms old (limit {limit_ms:.0} ms)")));
+                let mut why = format!("watchdog: last {what} {age_ms:.1} ms old (limit {limit_ms:.0} ms)");
+                // Peaks that arrive but do not map: say why.
+                if let (true, Some(unmapped)) = (name == "HYPERION", &l.unmapped) {
+                    why.push_str(&format!("; the newest do not map to the pads: {unmapped}"));
+                }
+                return Err(device(name, why));
             }
         }
         Ok(())
@@ -397,7 +412,10 @@ impl RealCell {
             if Instant::now() > deadline {
                 let why = match arm {
                     None => "no RTDE data package from the UR5e".to_string(),
-                    Some(_) if !sensor => "no peak frame from the interrogator".to_string(),
+                    Some(_) if !sensor => match d.peaks.lock().unwrap_or_else(|p| p.into_inner()).unmapped.clone() {
+                        Some(why) => format!("no peak frame with every grating in its window ({why})"),
+                        None => "no peak frame from the interrogator".to_string(),
+                    },
                     Some((s, _)) => format!(
                         "the follow program is not playing (RTDE runtime_state {}, robot_mode {}, safety_mode {})",
                         s.runtime_state, s.robot_mode, s.safety_mode
@@ -490,7 +508,7 @@ impl Cell for RealCell {
             growth_motor_rad,
             twine_motor_rad,
             wavelengths: latest.wavelengths,
-            array: Default::default(),
+            array: latest.array,
             tool_load_n: latest.tool_load_n,
         })
     }

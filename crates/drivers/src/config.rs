@@ -10,6 +10,10 @@
 //! [hardware.fbg]
 //! channel = 1
 //! fbg1_min_nm = 1535.0
+//! [[hardware.fbg.pads]]     # a sensor array's further pad 1 (optional: derived from [array])
+//! channel = 1
+//! fbg1_min_nm = 1500.0
+//! fbg1_max_nm = 1533.1
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -33,7 +37,8 @@ pub struct HardwareConfig {
     /// a sync read of both motors take about 6 ms of wire time at 57 600: run a 500 Hz loop at
     /// 1 M or more (set the motors' Baud Rate first).
     pub dxl_baud: u32,
-    /// Which interrogator channel and wavelength windows hold FBG1 and FBG2 \[nm\].
+    /// Which interrogator channel and wavelength windows hold FBG1 and FBG2 \[nm\] (and a sensor
+    /// array's further pads' gratings).
     pub fbg: FbgWindows,
 }
 

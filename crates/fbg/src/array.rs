@@ -328,7 +328,7 @@ impl ArrayConfig {
 
 /// Up to [`MAX_EXTRA_PADS`] values, one per further pad (pad 0's stay where they were without an
 /// array): a fixed size, so the per-tick readings stay `Copy` and allocate nothing.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct PerPad<T: Copy + Default> {
     len: u8,
     values: [T; MAX_EXTRA_PADS],
@@ -360,6 +360,13 @@ impl<T: Copy + Default> PerPad<T> {
     /// Whether there is none (the paper's single pad).
     pub fn is_empty(&self) -> bool {
         self.len == 0
+    }
+}
+
+impl<T: Copy + Default + PartialEq> PartialEq for PerPad<T> {
+    /// The pads' values only (the unused slots are not part of the value).
+    fn eq(&self, other: &Self) -> bool {
+        self.as_slice() == other.as_slice()
     }
 }
 

@@ -67,7 +67,7 @@ pub fn run<'py>(
                 )));
             }
             let devices = Devices { port_base, ..Devices::new(ur, dxl, interrogator) };
-            Target::Real(devices.config(&scenario).map_err(|e| PyValueError::new_err(e.to_string()))?)
+            Target::Real(Box::new(devices.config(&scenario).map_err(|e| PyValueError::new_err(e.to_string()))?))
         }
         other => return Err(PyValueError::new_err(format!("hardware: expected \"sim\" or \"real\", got {other:?}"))),
     };
@@ -109,7 +109,7 @@ pub fn run<'py>(
                 RealtimeOptions { priority: rt_priority, cpu: None, lock_memory: false }
                     .apply_to_current_thread()
                     .map_err(|e| anyhow::anyhow!("rt_priority {rt_priority}: {e}"))?;
-                run_on_real_with(scenario_ref, config, out, driver)
+                run_on_real_with(scenario_ref, *config, out, driver)
             }
         }
     });
@@ -124,10 +124,11 @@ pub fn run<'py>(
     Ok((text, columns, times))
 }
 
-/// Which cell a run drives.
+/// Which cell a run drives (the real cell's configuration boxed: with a sensor array's windows it
+/// is some 600 bytes).
 enum Target {
     Twin,
-    Real(RealCellConfig),
+    Real(Box<RealCellConfig>),
 }
 
 /// How often a waiting call looks for Ctrl-C \[s\]: well within a person's patience, and

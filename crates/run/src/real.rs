@@ -8,7 +8,7 @@ use super::scenario::PickPlaceScenario;
 use super::summary::RunSummary;
 use std::path::Path;
 use tendril_control::limits::{LimitedCell, SafetyLimits};
-use tendril_drivers::{RealCell, RealCellConfig};
+use tendril_drivers::{HardwareConfig, RealCell, RealCellConfig};
 
 /// Where the devices are and how strict the watchdogs are: what `tendril run --hardware real`
 /// takes on its command line (and `tendril.run(..., hardware="real")` as arguments). Motor IDs,
@@ -48,11 +48,12 @@ impl Devices {
     }
 
     /// The cell configuration for `scenario`: the interrogator period and `[hardware]` come from
-    /// it, the watchdogs from its control rate unless given. A limit below one period of its
-    /// stream or above 10 s, or a port base whose six ports do not fit, is refused with the reason.
+    /// it ([`hardware_for`]: with a sensor array, every pad's windows), the watchdogs from its
+    /// control rate unless given. A limit below one period of its stream or above 10 s, or a port
+    /// base whose six ports do not fit, is refused with the reason.
     pub fn config(&self, scenario: &PickPlaceScenario) -> anyhow::Result<RealCellConfig> {
         let mut c = RealCellConfig::new(&self.ur, &self.dxl, &self.interrogator);
-        c.hardware = scenario.hardware;
+        c.hardware = hardware_for(scenario)?;
         c.sensor_period_s = 1.0 / scenario.interrogator.sample_rate_hz;
         let mut c = c.with_control_rate(scenario.control_rate_hz);
         // The limits: at least one period of their stream, at most 10 s (a UR5e's own program
@@ -76,6 +77,19 @@ impl Devices {
             None => c,
         })
     }
+}
+
+/// The scenario's `[hardware]` with every pad's windows: with a sensor array, the further pads'
+/// `[[hardware.fbg.pads]]` as given, or derived from the `[array]` layout
+/// (`FbgWindows::for_layout` of `tendril_hyperion`); the single pad's unchanged. A layout the windows
+/// cannot read is refused with the key and the reason (as validation does).
+pub fn hardware_for(scenario: &PickPlaceScenario) -> anyhow::Result<HardwareConfig> {
+    let mut h = scenario.hardware;
+    h.fbg = h.fbg.for_layout(&scenario.array, &scenario.sensor).map_err(|faults| {
+        let lines: Vec<String> = faults.iter().map(|(key, reason)| format!("{key}: {reason}")).collect();
+        anyhow::anyhow!("scenario {}: {}", scenario.name, lines.join("; "))
+    })?;
+    Ok(h)
 }
 
 /// A port base whose six ports N..N+5 fit below 65536.
@@ -103,6 +117,14 @@ pub fn run_on_real_with(
 ) -> anyhow::Result<(RunSummary, RunReport)> {
     // Disturbances are the twin's: refuse before any device is contacted.
     scenario.disturbance.refuse_on_real().map_err(|e| anyhow::anyhow!("{e}"))?;
+    // A configuration made by hand for a sensor array's scenario must read every pad, or the run
+    // would control on pad 0 alone without a word.
+    let (windows, pads) = (config.hardware.fbg.pads.len(), scenario.array.pads.len());
+    anyhow::ensure!(
+        windows == pads,
+        "the real cell's configuration has windows for {windows} further pad(s), the scenario's [array] has {pads}: \
+         make it with Devices::config or hardware_for"
+    );
     let started = super::clock::RunClock::start();
     let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator);
     let mut cell = LimitedCell::new(RealCell::new(config), limits);

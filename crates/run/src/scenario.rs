@@ -172,6 +172,8 @@ impl Validate for PickPlaceScenario {
             at.section("array", &self.array);
             self.check_array(at);
         }
+        // Pad windows given without an array are refused there too.
+        self.check_array_windows(at);
     }
 }
 
@@ -243,6 +245,22 @@ impl PickPlaceScenario {
         });
         for (key, reason) in self.array.multiplexing_faults(&self.sensor, self.hardware.fbg.channel) {
             at.require(&key, false, || reason);
+        }
+    }
+
+    /// The windows the real path reads a sensor array with (`[hardware.fbg]`, and
+    /// `[[hardware.fbg.pads]]` as given or derived from `[array]`): one per further pad, each on
+    /// its pad's channel holding its grating's range, the windows on a channel disjoint
+    /// (`FbgWindows::for_layout`). Windows for pads the scenario does not have are refused too.
+    fn check_array_windows(&self, at: &mut Checker) {
+        // A layout whose gratings meet is refused by `check_array` already.
+        if !self.array.multiplexing_faults(&self.sensor, self.hardware.fbg.channel).is_empty() {
+            return;
+        }
+        if let Err(faults) = self.hardware.fbg.for_layout(&self.array, &self.sensor) {
+            for (key, reason) in faults {
+                at.require(&key, false, || reason);
+            }
         }
     }
 

@@ -20,7 +20,8 @@ pub struct ServeHandle {
     pub ur_addrs: UrAddrs,
     /// The devices' shared state (for tests comparing with the twin).
     pub state: Arc<std::sync::Mutex<DeviceState>>,
-    /// The motor IDs, bus speed and FBG channel served (the scenario's `[hardware]`).
+    /// The motor IDs, bus speed and FBG windows served (the scenario's `[hardware]`, with a sensor
+    /// array's further pads' windows).
     pub hardware: HardwareConfig,
     stop: Arc<AtomicBool>,
     twin: Option<std::thread::JoinHandle<Result<(), String>>>,
@@ -77,7 +78,9 @@ impl Drop for ServeHandle {
 pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Result<ServeHandle> {
     anyhow::ensure!(config.period_s > 0.0 && config.period_s <= 0.01, "twin period must be in (0, 10 ms]");
     let stop = Arc::new(AtomicBool::new(false));
-    let hardware = scenario.hardware;
+    // With a sensor array, every pad's windows (given, or derived from the layout): the real
+    // cell `real_cell_config` describes reads every pad.
+    let hardware = tendril_run::real::hardware_for(scenario)?;
     let (state, ticks) = shared_state(&hardware, &scenario.interrogator.spectral, &config.ur)?;
     let rt = config.realtime;
     // Fail early and clearly rather than in each thread.

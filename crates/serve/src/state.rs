@@ -90,7 +90,7 @@ pub struct DeviceState {
 
 /// The shared state and the tick channel (the twin sends its tick count after each update): the
 /// motors at `hardware`'s IDs and bus speed, an interrogator with enough channels for its FBG
-/// channel, whose `#GetSpectrum` draws lines as `spectral` describes them.
+/// channels (every pad's), whose `#GetSpectrum` draws lines as `spectral` describes them.
 pub fn shared_state(
     hardware: &HardwareConfig,
     spectral: &SpectralConfig,
@@ -105,8 +105,8 @@ pub fn shared_state(
         }
     }
     // The si255 has 1, 4, 8 or 16 channels: the virtual one keeps its default 4 unless the FBG
-    // channel needs more.
-    let channel_count = [4, 8, 16].into_iter().find(|&n| n >= hardware.fbg.channel).unwrap_or(16) as u32;
+    // channels (pad 0's and a sensor array's further pads') need more.
+    let channel_count = [4, 8, 16].into_iter().find(|&n| n >= hardware.fbg.highest_channel()).unwrap_or(16) as u32;
     let interrogator = VirtualInterrogator::new(InterrogatorConfig {
         channel_count,
         spectral: spectral.clone(),

@@ -70,7 +70,8 @@ pub fn spawn(
 ) -> anyhow::Result<std::thread::JoinHandle<Result<(), String>>> {
     let model = SceneModel::build(&scenario.scene_spec())?;
     let motors = scenario.hardware.motor_ids();
-    let channel = scenario.hardware.fbg.channel;
+    // Where each pad's gratings are: every peak of the layout is served on its channel.
+    let windows = tendril_run::real::hardware_for(&scenario)?.fbg;
     let (ready, started) = std::sync::mpsc::sync_channel(1);
     let run = move || -> Result<(), String> {
         let _ = realtime.apply_to_current_thread();
@@ -231,9 +232,9 @@ pub fn spawn(
                         timestamp_ns: (scan_s.fract() * 1e9) as u32,
                         ..PeakHeader::default()
                     },
-                    channels: (1..=channel)
-                        .map(|c| if c == channel { vec![r.wavelengths.fbg1_nm, r.wavelengths.fbg2_nm] } else { vec![] })
-                        .collect(),
+                    // Every grating of the layout on its channel, each channel's peaks in ascending
+                    // wavelength (pad 0's two; a further pad's FBG1, and its FBG2 if it has its own).
+                    channels: windows.peak_channels(r.wavelengths, &r.array),
                 };
                 s.interrogator.set_peaks(frame).map_err(|e| e.to_string())?;
                 s.status = TwinStatus {
