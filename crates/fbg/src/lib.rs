@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 pub mod array;
+pub mod array_spectrum;
 pub mod bench;
 pub mod calibration;
 mod config;

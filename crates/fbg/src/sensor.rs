@@ -74,8 +74,10 @@ impl FbgSensor {
         Wavelengths { fbg1_nm: self.quantize(p1), fbg2_nm: self.quantize(p2) }
     }
 
+    /// `nm` on the interrogator's reporting step (`quantization_pm`), as [`FbgSensor::sample`]
+    /// reports it.
     #[inline]
-    fn quantize(&self, nm: f64) -> f64 {
+    pub fn quantize(&self, nm: f64) -> f64 {
         if self.quantization_pm > 0.0 {
             let q = self.quantization_pm * 1e-3;
             (nm / q).round() * q

@@ -19,7 +19,7 @@ use tendril_control::task::TaskConfig;
 use tendril_drivers::HardwareConfig;
 use tendril_fbg::array::ArrayConfig;
 use tendril_fbg::estimate::ForceCalibration;
-use tendril_fbg::{InterrogatorConfig, InterrogatorMode, SensorConfig};
+use tendril_fbg::{InterrogatorConfig, SensorConfig};
 use tendril_twin::disturbance::DisturbanceConfig;
 use tendril_twin::physics::{FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, SceneModel, SceneSpec};
 use tendril_twin::sim::{EnvironmentConfig, SimCell};
@@ -183,7 +183,7 @@ impl PickPlaceScenario {
         SimCell::new(model, self.sensor.clone(), self.interrogator.clone(), self.gripper, self.environment, self.seed)
             .with_disturbances(self.disturbance.clone())
             .with_wrist(self.wrist)
-            .with_array(&self.array)
+            .with_array(&self.array, self.hardware.fbg.channel)
     }
 
     /// The FBG windows must hold the gratings `[sensor]` describes (the twin behind `tendril serve`
@@ -238,11 +238,6 @@ impl PickPlaceScenario {
                 });
             }
         }
-        at.require("array.pads", self.interrogator.mode == InterrogatorMode::Analytic, || {
-            "a sensor array is read in interrogator.mode = \"analytic\" only (the spectral model has one \
-             strain and one reference line)"
-                .into()
-        });
         for (key, reason) in self.array.multiplexing_faults(&self.sensor, self.hardware.fbg.channel) {
             at.require(&key, false, || reason);
         }

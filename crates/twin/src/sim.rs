@@ -7,6 +7,8 @@
 use super::disturbance::{DisturbanceConfig, DisturbanceSchedule};
 use super::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel};
 use super::wrist::{WristConfig, WristSensor};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 use tendril_cell::Phase;
@@ -14,6 +16,7 @@ use tendril_cell::gripper::GripperConfig;
 use tendril_cell::{Cell, CellCommand, CellError, CellState, GroundTruth, Lifecycle, require_state};
 use tendril_config::{Checker, Validate};
 use tendril_fbg::array::{ArrayConfig, ArrayPeaks};
+use tendril_fbg::array_spectrum::ArraySpectra;
 use tendril_fbg::signals::Wavelengths;
 use tendril_fbg::{FbgSensor, InterrogatorConfig, SensorConfig};
 
@@ -67,6 +70,9 @@ pub struct SimCell {
     array: Vec<PadSensor>,
     /// Their latest samples.
     latest_array: ArrayPeaks,
+    /// In spectral mode, every grating of the array in its channel's one spectrum, and the noise
+    /// stream of those spectra (`None`: each pad's peaks drawn on their own, analytic mode).
+    spectra: Option<(ArraySpectra, ArraySpectraSource)>,
     next_sample_s: f64,
     /// The physics readout after the last step, read once per tick by `read`, the sensor and
     /// the ground truth alike.
@@ -86,6 +92,17 @@ pub struct SimCell {
     count_contacts: bool,
 }
 
+/// What rebuilds the array's spectra for a new run: the layout's windows and the noise seed.
+#[derive(Debug, Clone)]
+struct ArraySpectraSource {
+    windows: Vec<tendril_fbg::array::GratingWindow>,
+    rng: ChaCha8Rng,
+}
+
+/// The noise seed of the array's spectra: a stream of its own beside every pad's (pad numbers
+/// stop at 8, so 1000 is no pad's).
+const SPECTRA_STREAM: usize = 1000;
+
 /// A further pad's sensor model, and whether it reads pad 0's reference grating instead of its own.
 #[derive(Debug, Clone)]
 struct PadSensor {
@@ -104,9 +121,18 @@ fn pad_seed(seed: u64, k: usize) -> u64 {
 impl SimCell {
     /// Reads the further pads of `array` besides pad 0 (`[array]`): each its own sensor model
     /// (`sensor` with the pad's wavelengths) and noise stream, sampled at pad 0's instants with
-    /// its own contact force. The scene must carry the same pads (`SceneSpec::extra_pads`);
-    /// [`Cell::configure`] refuses it otherwise.
-    pub fn with_array(mut self, array: &ArrayConfig) -> SimCell {
+    /// its own contact force. In spectral mode every grating, pad 0's included, is read from its
+    /// channel's one spectrum (`tendril_fbg::array_spectrum`), pad 0 on `first_channel`. The scene
+    /// must carry the same pads (`SceneSpec::extra_pads`); [`Cell::configure`] refuses it
+    /// otherwise.
+    pub fn with_array(mut self, array: &ArrayConfig, first_channel: usize) -> SimCell {
+        self.spectra =
+            (self.interrogator.mode == tendril_fbg::InterrogatorMode::Spectral && !array.is_single()).then(|| {
+                let windows = array.windows(&self.sensor_config, first_channel);
+                let source =
+                    ArraySpectraSource { windows, rng: ChaCha8Rng::seed_from_u64(pad_seed(self.seed, SPECTRA_STREAM)) };
+                (ArraySpectra::new(&self.interrogator.spectral, &source.windows), source)
+            });
         self.array = (1..=array.pads.len())
             .map(|k| {
                 let config = array.pad_sensor(&self.sensor_config, k);
@@ -206,6 +232,7 @@ impl SimCell {
             latest: Wavelengths { fbg1_nm: 0.0, fbg2_nm: 0.0 },
             array: Vec::new(),
             latest_array: ArrayPeaks::default(),
+            spectra: None,
             next_sample_s: 0.0,
             readout: PhysicsReadout::default(),
             disturbances: DisturbanceSchedule::default(),
@@ -291,21 +318,53 @@ impl SimCell {
             let temperature = self.environment.temperature_at(self.next_sample_s);
             // The sensor model runs through a dropout (its noise and thermal state advance); only
             // the delivery is lost. The first sample (the activation's) is always delivered.
-            let sample = self.sensor.sample(force, temperature, dt);
             let deliver = self.next_sample_s == 0.0 || !self.disturbances.sample_dropped(self.next_sample_s);
+            let forces = self.readout.extra_pad_forces_n;
+            let (sample, pads) = match self.spectra.as_mut() {
+                None => {
+                    let sample = self.sensor.sample(force, temperature, dt);
+                    let mut pads = ArrayPeaks::filled(self.array.len(), Wavelengths::default());
+                    for (k, pad) in self.array.iter_mut().enumerate() {
+                        let mut w = pad.model.sample(forces.as_slice()[k], temperature, dt);
+                        if pad.shares_reference {
+                            w.fbg2_nm = sample.fbg2_nm;
+                        }
+                        pads.as_mut_slice()[k] = w;
+                    }
+                    (sample, pads)
+                }
+                Some((spectra, source)) => {
+                    // Every grating's true wavelength, in the layout's windows' order (pad 0's
+                    // two, then each further pad's strain grating and its own reference if any).
+                    let b0 = self.sensor.bragg(force, temperature, dt);
+                    let mut lines = vec![b0.fbg1_nm, b0.fbg2_nm];
+                    let mut own = Vec::with_capacity(self.array.len());
+                    for (k, pad) in self.array.iter_mut().enumerate() {
+                        let b = pad.model.bragg(forces.as_slice()[k], temperature, dt);
+                        lines.push(b.fbg1_nm);
+                        if !pad.shares_reference {
+                            lines.push(b.fbg2_nm);
+                        }
+                        own.push(!pad.shares_reference);
+                    }
+                    let found = spectra.detect(&lines, &mut source.rng);
+                    let q = |nm: f64| self.sensor.quantize(nm);
+                    let sample = Wavelengths { fbg1_nm: q(found[0]), fbg2_nm: q(found[1]) };
+                    let mut pads = ArrayPeaks::filled(self.array.len(), Wavelengths::default());
+                    let mut at = 2;
+                    for (k, &has_own) in own.iter().enumerate() {
+                        let fbg1_nm = q(found[at]);
+                        let fbg2_nm = if has_own { q(found[at + 1]) } else { sample.fbg2_nm };
+                        at += 1 + usize::from(has_own);
+                        pads.as_mut_slice()[k] = Wavelengths { fbg1_nm, fbg2_nm };
+                    }
+                    (sample, pads)
+                }
+            };
             if deliver {
                 self.latest = sample;
+                self.latest_array = pads;
                 self.fresh_sample = true;
-            }
-            let forces = self.readout.extra_pad_forces_n;
-            for (k, pad) in self.array.iter_mut().enumerate() {
-                let mut w = pad.model.sample(forces.as_slice()[k], temperature, dt);
-                if pad.shares_reference {
-                    w.fbg2_nm = sample.fbg2_nm;
-                }
-                if deliver {
-                    self.latest_array.as_mut_slice()[k] = w;
-                }
             }
             self.next_sample_s += dt;
         }
@@ -331,6 +390,10 @@ impl Cell for SimCell {
         self.sensor = FbgSensor::new(&self.sensor_config, &self.interrogator, self.seed);
         for (k, pad) in self.array.iter_mut().enumerate() {
             pad.model = FbgSensor::new(&pad.config, &self.interrogator, pad_seed(self.seed, k + 1));
+        }
+        if let Some((spectra, source)) = self.spectra.as_mut() {
+            *spectra = ArraySpectra::new(&self.interrogator.spectral, &source.windows);
+            source.rng = ChaCha8Rng::seed_from_u64(pad_seed(self.seed, SPECTRA_STREAM));
         }
         let pads_in_scene = self.model.spec().extra_pads.len();
         if pads_in_scene != self.array.len() {
