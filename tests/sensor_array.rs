@@ -186,8 +186,34 @@ fn the_array_cue_fires_before_a_knocked_drop_and_not_in_a_held_run() {
     let held = crimper_with_array(&[], &dir.path().join("held"));
     assert_eq!(held["outcome"], "held");
     assert_eq!(held["array"]["cue_alarms"], 0, "{}", held["array"]);
-    assert_eq!(held["array"]["pads"].as_array().unwrap().len(), 3);
+    assert_eq!(held["array"]["pad_figures"].as_array().unwrap().len(), 3);
     // The low pad where the wrap starts reads the crimper's wrap (0.4 N mean while holding).
-    let base = held["array"]["pads"][1]["mean_true_n"].as_f64().unwrap();
+    let base = held["array"]["pad_figures"][1]["mean_true_n"].as_f64().unwrap();
     assert!(base > 0.1, "pad 1 carried {base} N");
+}
+
+/// The shipped array sweep runs as its comment says: 27 runs, none failing, every undisturbed run
+/// held.
+#[test]
+fn the_array_sweep_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_tendril"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["sweep", "scenarios/sweep-disturbed-array.toml", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut r = csv::Reader::from_path(dir.path().join("results.csv")).unwrap();
+    let header = r.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (outcome, impulse) = (col("outcome"), col("disturbance.push.impulse_n_s"));
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 27);
+    for row in &rows {
+        assert_ne!(&row[outcome], "error", "{row:?}");
+        if &row[impulse] == "0.0" {
+            assert_eq!(&row[outcome], "held", "{row:?}");
+        }
+    }
 }

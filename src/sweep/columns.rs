@@ -3,7 +3,7 @@
 
 use super::spec::{Sweep, SweepRun};
 use std::path::Path;
-use tendril_run::summary::{RunSummary, flatten_summary};
+use tendril_run::summary::RunSummary;
 
 /// Renders a swept value for a cell: strings bare, everything else as TOML writes it.
 fn value_text(v: &toml::Value) -> String {
@@ -82,6 +82,6 @@ fn one_line(cell: String) -> String {
 /// always recognisable as a last line without its newline.
 pub fn row(sweep: &Sweep, id: &str, run: &SweepRun, summary: &RunSummary) -> Vec<String> {
     let mut r = identity_cells(sweep, id, run);
-    r.extend(flatten_summary(summary).into_iter().map(|(_, v)| v));
+    r.extend(summary.cells());
     r.into_iter().map(one_line).collect()
 }

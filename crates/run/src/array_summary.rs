@@ -25,8 +25,9 @@ pub struct PadFigures {
 /// The array's part of a run's summary.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ArraySummary {
-    /// Each pad's figures, pad 0 first.
-    pub pads: Vec<PadFigures>,
+    /// Each pad's figures, pad 0 first (`pad_figures`, not `pads`: a sweep over `array.pads`
+    /// has a column of that name).
+    pub pad_figures: Vec<PadFigures>,
     /// Alarm episodes of the array's slip cue.
     pub cue_alarms: u64,
     /// The cue's first alarm, from the start of the arm's motion \[s\].
@@ -81,7 +82,7 @@ pub fn summarise(
     let since_motion = |t: f64| motion_start_s.map(|m| t - m);
     let judgement = has_truth.then(|| judge(cue_alarms_s, drop_s));
     ArraySummary {
-        pads: figures,
+        pad_figures: figures,
         cue_alarms: cue_alarms_s.len() as u64,
         cue_first_alarm_s: cue_alarms_s.first().and_then(|&t| since_motion(t)),
         cue_detection_delay_s: judgement.and_then(|j| j.detection_delay_s),

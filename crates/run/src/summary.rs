@@ -131,7 +131,16 @@ impl RunSummary {
 
     /// The column names of a flattened summary, in order (nested fields dotted: `gains.kp`).
     pub fn columns() -> Vec<String> {
-        flatten_summary(&RunSummary::default()).into_iter().map(|(k, _)| k).collect()
+        // A sensor array's columns too, so that one results file holds runs with and without one
+        // (empty for the paper's single pad); a real cell's device timing is not a sweep's.
+        let with_array = RunSummary { array: Some(Default::default()), ..RunSummary::default() };
+        flatten_summary(&with_array).into_iter().map(|(k, _)| k).collect()
+    }
+
+    /// The cells of this summary in [`RunSummary::columns`]' order (empty where it has no value).
+    pub fn cells(&self) -> Vec<String> {
+        let mut values: std::collections::HashMap<String, String> = flatten_summary(self).into_iter().collect();
+        RunSummary::columns().into_iter().map(|k| values.remove(&k).unwrap_or_default()).collect()
     }
 
     /// Builds the summary from a run's identity, report, wall time and CPU time.
@@ -244,7 +253,7 @@ pub fn render_text(s: &RunSummary) -> String {
 fn render_array(a: &super::array_summary::ArraySummary) -> String {
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2}"));
     let mut out = String::new();
-    for p in &a.pads {
+    for p in &a.pad_figures {
         out += &format!(
             "  pad {}              true {} N, peak {} N, RMSE {} N while holding",
             p.pad,
