@@ -217,3 +217,28 @@ fn the_array_sweep_runs() {
         }
     }
 }
+
+/// A pad given its own calibration (`[[array.calibrations]]`, from a bench run on that pad) is
+/// estimated with it; the others are not; a list of the wrong length is refused.
+#[test]
+fn a_pad_is_estimated_with_its_own_calibration() {
+    let (k, r) = refusal(&["array.pads=[{arc_m=0.03,lambda1_nm=1525.0}]", "array.calibrations=[{},{}]"]);
+    assert_eq!(k, "array.calibrations", "{r}");
+    let dir = tempfile::tempdir().unwrap();
+    let short = ["scenarios/crimper.toml", "--set", "task.grasp_s=3", "--set"];
+    let layout = "array.pads=[{arc_m=0.012,lambda1_nm=1525.0,protrusion_m=0.0025},{arc_m=0.0775,lambda1_nm=1560.0}]";
+    let (plain, _) = run(&[&short[..], &[layout]].concat(), &dir.path().join("plain"));
+    let own = [&short[..], &[layout, "--set", "array.calibrations=[{b_pm_per_n=600.0},{}]"]].concat();
+    let (calibrated, _) = run(&own, &dir.path().join("own"));
+    let column = |trace: &str, name: &str| -> Vec<f64> {
+        let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+        let at = header.iter().position(|h| *h == name).unwrap();
+        trace.lines().skip(1).map(|l| l.split(',').nth(at).unwrap().parse().unwrap()).collect()
+    };
+    assert_eq!(column(&plain, "force_n"), column(&calibrated, "force_n"), "pad 0 keeps [estimator]'s");
+    assert_eq!(column(&plain, "pad2_force_n"), column(&calibrated, "pad2_force_n"), "pad 2 too");
+    let (a, b) = (column(&plain, "pad1_force_n"), column(&calibrated, "pad1_force_n"));
+    // A steeper b reads the same shift as less force, where the pad is loaded.
+    let loaded: Vec<(f64, f64)> = a.iter().zip(&b).filter(|(x, _)| **x > 0.3).map(|(x, y)| (*x, *y)).collect();
+    assert!(!loaded.is_empty() && loaded.iter().all(|(x, y)| y < x), "pad 1: {loaded:?}");
+}

@@ -127,6 +127,11 @@ pub struct ArrayConfig {
     /// Acting on the cue: from its first alarm in a carry the setpoint is multiplied by this
     /// factor for the rest of the run [-]; 1: the cue only reports (the default).
     pub retighten_factor: f64,
+    /// Each further pad's own eq. 8 calibration, in `pads`' order (`[[array.calibrations]]`, the
+    /// keys of `[estimator]`), from the bench procedures run on that pad; empty: every pad uses
+    /// `[estimator]`'s (the pads are one build).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub calibrations: Vec<crate::estimate::ForceCalibration>,
 }
 
 impl Default for ArrayConfig {
@@ -141,6 +146,7 @@ impl Default for ArrayConfig {
             cue_tau_s: 1.0,
             cue_min_load_n: 0.2,
             retighten_factor: 1.0,
+            calibrations: Vec::new(),
         }
     }
 }
@@ -181,6 +187,12 @@ impl Validate for ArrayConfig {
         // At most 3×: a setpoint above the sensor's range is refused anyway, and the grip's
         // force grows with it (docs/guide/array.md).
         at.in_range("retighten_factor", self.retighten_factor, 1.0, 3.0);
+        at.require("calibrations", self.calibrations.is_empty() || self.calibrations.len() == self.pads.len(), || {
+            format!("one per further pad ({}) or none, got {}", self.pads.len(), self.calibrations.len())
+        });
+        for (i, c) in self.calibrations.iter().enumerate() {
+            at.section(&format!("calibrations[{i}]"), c);
+        }
     }
 }
 

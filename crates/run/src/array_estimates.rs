@@ -2,7 +2,8 @@
 //! as pad 0's (`crate::session`).
 //!
 //! Every pad is the same build as the paper's (casing, uvula, gratings' sensitivities), so the
-//! bench calibration of `[estimator]` is each pad's calibration; what differs between pads, their
+//! bench calibration of `[estimator]` is each pad's calibration unless `[[array.calibrations]]`
+//! gives each its own (a lab's bench run on each pad); what differs between pads anyway, their
 //! unloaded wavelengths, is what the tare at home takes out.
 
 use super::samples::{InvalidSamples, TareAverager};
@@ -26,13 +27,13 @@ pub(crate) struct ArrayEstimates {
 }
 
 impl ArrayEstimates {
-    /// Estimators for the pads `peaks` carries, each with `calibration`, made at the first reading
-    /// (the cell says how many pads it reads).
-    fn ensure(&mut self, peaks: &ArrayPeaks, calibration: &ForceCalibration) {
+    /// Estimators for the pads `peaks` carries, pad k with `own[k-1]` or else `calibration`, made
+    /// at the first reading (the cell says how many pads it reads).
+    fn ensure(&mut self, peaks: &ArrayPeaks, calibration: &ForceCalibration, own: &[ForceCalibration]) {
         if self.pads.len() != peaks.len() {
             self.pads = (0..peaks.len())
-                .map(|_| PadEstimator {
-                    estimator: ForceEstimator::new(calibration.clone()),
+                .map(|k| PadEstimator {
+                    estimator: ForceEstimator::new(own.get(k).unwrap_or(calibration).clone()),
                     tare: TareAverager::default(),
                     invalid: InvalidSamples::default(),
                     unloaded_n: 0.0,
@@ -42,8 +43,8 @@ impl ArrayEstimates {
     }
 
     /// Adds a sample at home, finger untouched, to each pad's tare (a non-finite one is left out).
-    pub(crate) fn tare(&mut self, peaks: &ArrayPeaks, calibration: &ForceCalibration) {
-        self.ensure(peaks, calibration);
+    pub(crate) fn tare(&mut self, peaks: &ArrayPeaks, calibration: &ForceCalibration, own: &[ForceCalibration]) {
+        self.ensure(peaks, calibration, own);
         for (pad, w) in self.pads.iter_mut().zip(peaks.as_slice()) {
             if w.fbg1_nm.is_finite() && w.fbg2_nm.is_finite() {
                 pad.tare.add(*w);
@@ -62,8 +63,9 @@ impl ArrayEstimates {
         peaks: &ArrayPeaks,
         held: bool,
         calibration: &ForceCalibration,
+        own: &[ForceCalibration],
     ) -> Result<PerPad<f64>, String> {
-        self.ensure(peaks, calibration);
+        self.ensure(peaks, calibration, own);
         let mut out = PerPad::filled(self.pads.len(), f64::NAN);
         for (k, (pad, w)) in self.pads.iter_mut().zip(peaks.as_slice()).enumerate() {
             let estimate = match (held, pad.invalid.last_valid) {

@@ -291,7 +291,7 @@ impl<C: Cell> Session<C> {
             self.estimator.tare(mean);
             self.unloaded_n = self.estimator.estimate(mean).map_or(0.0, |e| e.force_n);
             self.sequencer.set_unloaded_reading(self.unloaded_n);
-            self.array.tare(&state.array, &self.plan.calibration);
+            self.array.tare(&state.array, &self.plan.calibration, &self.plan.array.calibrations);
         }
         if self.sequencer.phase() == Phase::Home {
             self.slip.observe_home_load(state.tool_load_n);
@@ -306,9 +306,14 @@ impl<C: Cell> Session<C> {
                 cause: format!("at t = {:.3} s: {cause}", state.time_s),
             })?,
         };
-        let array = self.array.estimate(&state.array, held.is_some(), &self.plan.calibration).map_err(|cause| {
-            CellError::Device { device: "estimator".into(), cause: format!("at t = {:.3} s: {cause}", state.time_s) }
-        })?;
+        let own = &self.plan.array.calibrations;
+        let array =
+            self.array.estimate(&state.array, held.is_some(), &self.plan.calibration, own).map_err(|cause| {
+                CellError::Device {
+                    device: "estimator".into(),
+                    cause: format!("at t = {:.3} s: {cause}", state.time_s),
+                }
+            })?;
         let control_force_n = if array.is_empty() {
             estimate.force_n
         } else {
