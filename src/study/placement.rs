@@ -281,7 +281,7 @@ fn run_cells(r: &PlacementRun) -> Vec<String> {
 
 /// How early an alarm must come to count as seeing a drop in time to act \[s\]: within 0.3 s of
 /// it, as `tendril chart controllers` counts the slip detector's ("drops seen ≤ 0.3 s").
-const SEEN_WITHIN_S: f64 = 0.3;
+pub const SEEN_WITHIN_S: f64 = 0.3;
 
 /// One (layout, object, disturbance set, feedback) over its seeds.
 #[derive(Debug, Clone, PartialEq)]

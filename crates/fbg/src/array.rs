@@ -12,7 +12,7 @@
 //! grating's peak moves over a *window* (its unloaded wavelength, plus the strain span up to the
 //! sensor's range, plus the thermal shift over the operating temperatures), and the windows on
 //! one channel must keep [`ArrayConfig::guard_nm`] apart and inside the interrogator's band, or two
-//! peaks could meet and the interrogator would see one. [`ArrayConfig::check`] refuses such a
+//! peaks could meet and the interrogator would see one. [`ArrayConfig::multiplexing_faults`] refuses such a
 //! layout with the key and the reason.
 
 use crate::config::SensorConfig;
