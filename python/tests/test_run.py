@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import tendril
-from conftest import SHORT_LIFT, without_timing
+from conftest import ROOT, SHORT_LIFT, without_timing
 
 
 @pytest.fixture(scope="module")
@@ -184,3 +184,19 @@ def test_bad_arguments_are_named():
         tendril.run(42)
     with pytest.raises(tendril.ScenarioError):
         tendril.run(SHORT_LIFT.with_name("none.toml"))
+
+
+def test_a_sensor_arrays_pads_are_in_the_trace_and_the_observation(tmp_path):
+    """hammer-array's three pads: the trace's array columns as `trace.csv` has them, and each
+    further pad's estimate in a session's observation."""
+    scenario = tendril.load(ROOT / "scenarios" / "hammer-array.toml", set={"task.grasp_s": 3})
+    run = tendril.run(scenario, out=tmp_path)
+    header = (tmp_path / "trace.csv").read_text().splitlines()[0].split(",")
+    assert list(run.trace) == header
+    assert header[-1] == "control_force_n" and "pad2_force_n" in header
+    np.testing.assert_array_equal(run.trace["control_force_n"], run.trace["force_n"])
+    assert run.summary["array"]["pad_figures"][1]["pad"] == 1
+    session = tendril.Session(scenario)
+    observation = session.observation()
+    assert len(observation["array_force_n"]) == 2
+    assert observation["control_force_n"] == observation["force_n"]

@@ -1,6 +1,6 @@
 //! A run's trace as columns (what `tendril.Run.trace` turns into numpy arrays) and one tick as a
 //! dict: the columns of `trace.csv`, in its order, at full precision (the file rounds to 3-5
-//! decimals).
+//! decimals), a sensor array's after them as in the file.
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -42,31 +42,57 @@ pub fn names() -> Vec<&'static str> {
     COLUMNS.iter().map(|(name, _)| *name).collect()
 }
 
+/// A sensor array's columns of a row, in `trace.csv`'s order and names: each further pad's true
+/// force, peaks and estimate, then the force the controller regulated (none without an array).
+fn array_cells(r: &TraceRow) -> Vec<(String, f64)> {
+    let pads = r.array.pads.as_slice();
+    let mut out = Vec::with_capacity(4 * pads.len() + 1);
+    for (i, p) in pads.iter().enumerate() {
+        let k = i + 1;
+        out.push((format!("pad{k}_true_force_n"), p.true_force_n));
+        out.push((format!("pad{k}_fbg1_nm"), p.fbg1_nm));
+        out.push((format!("pad{k}_fbg2_nm"), p.fbg2_nm));
+        out.push((format!("pad{k}_force_n"), p.force_n));
+    }
+    if !pads.is_empty() {
+        out.push(("control_force_n".to_string(), r.array.control_force_n));
+    }
+    out
+}
+
 /// Every column of `rows` as `(name, kind, data)`: kind `"f8"` with little-endian float64
 /// bytes, `"bool"` with one byte a row, or `"str"` with a list of the phases' names.
-pub fn columns<'py>(
-    py: Python<'py>,
-    rows: &[TraceRow],
-) -> PyResult<Vec<(&'static str, &'static str, Bound<'py, PyAny>)>> {
-    COLUMNS
+pub fn columns<'py>(py: Python<'py>, rows: &[TraceRow]) -> PyResult<Vec<(String, &'static str, Bound<'py, PyAny>)>> {
+    let mut out = COLUMNS
         .iter()
         .map(|(name, column)| {
             Ok(match column {
                 Column::Float(f) => {
                     let bytes: Vec<u8> = rows.iter().flat_map(|r| f(r).to_le_bytes()).collect();
-                    (*name, "f8", PyBytes::new(py, &bytes).into_any())
+                    (name.to_string(), "f8", PyBytes::new(py, &bytes).into_any())
                 }
                 Column::Flag(f) => {
                     let bytes: Vec<u8> = rows.iter().map(|r| u8::from(f(r))).collect();
-                    (*name, "bool", PyBytes::new(py, &bytes).into_any())
+                    (name.to_string(), "bool", PyBytes::new(py, &bytes).into_any())
                 }
                 Column::Phase => {
                     let phases: Vec<&str> = rows.iter().map(|r| r.phase.name()).collect();
-                    (*name, "str", phases.into_pyobject(py)?.into_any())
+                    (name.to_string(), "str", phases.into_pyobject(py)?.into_any())
                 }
             })
         })
-        .collect()
+        .collect::<PyResult<Vec<_>>>()?;
+    let names: Vec<String> = rows.first().map(array_cells).unwrap_or_default().into_iter().map(|(n, _)| n).collect();
+    let mut data: Vec<Vec<u8>> = vec![Vec::with_capacity(8 * rows.len()); names.len()];
+    for r in rows {
+        for (bytes, (_, value)) in data.iter_mut().zip(array_cells(r)) {
+            bytes.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    for (name, bytes) in names.into_iter().zip(data) {
+        out.push((name, "f8", PyBytes::new(py, &bytes).into_any()));
+    }
+    Ok(out)
 }
 
 /// One row as a dict of the same columns.
@@ -78,6 +104,9 @@ pub fn row_dict<'py>(py: Python<'py>, r: &TraceRow) -> PyResult<Bound<'py, PyDic
             Column::Flag(f) => d.set_item(name, f(r))?,
             Column::Phase => d.set_item(name, r.phase.name())?,
         }
+    }
+    for (name, value) in array_cells(r) {
+        d.set_item(name, value)?;
     }
     Ok(d)
 }

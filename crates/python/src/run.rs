@@ -25,7 +25,7 @@ use tendril_run::summary::RunSummary;
 use tendril_twin::physics::Backend;
 
 /// The trace's columns as Python gets them (`(name, kind, data)`, see [`columns`]).
-type Columns<'py> = Vec<(&'static str, &'static str, Bound<'py, PyAny>)>;
+type Columns<'py> = Vec<(String, &'static str, Bound<'py, PyAny>)>;
 
 /// Runs `scenario` (a `Scenario` or a scenario file's path) as `tendril run` does: `seed`,
 /// `feedback` (`True`/`False` or `"on"`/`"off"`) and `backend` (`"mujoco"`/`"rapier"`) are

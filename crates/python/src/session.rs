@@ -98,8 +98,9 @@ impl Session {
 
     /// The latest reading, which the next `step` acts on, as a dict (`None` once the run is over):
     /// `time_s`, `phase`, `phase_index`, `fbg1_nm`, `fbg2_nm`, `delta1_pm` and `delta2_pm` (the
-    /// gratings' shifts from the tare), `force_n`, `force_uncompensated_n`, `over_range`,
-    /// `setpoint_n`, `time_to_motion_s`, `arm_q_rad`, `growth_motor_rad`, `twine_motor_rad`,
+    /// gratings' shifts from the tare), `force_n`, `array_force_n` (a sensor array's further pads'
+    /// estimates, empty without one), `control_force_n` (what the controller regulates),
+    /// `force_uncompensated_n`, `over_range`, `setpoint_n`, `time_to_motion_s`, `arm_q_rad`, `growth_motor_rad`, `twine_motor_rad`,
     /// `tool_load_n` and `truth` (the ground truth: `sensor_force_n`, `grip_force_n`,
     /// `object_height_m`, `slip_speed_m_s`, `in_contact`).
     fn observation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
@@ -215,6 +216,8 @@ fn observation_dict<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py
     d.set_item("delta1_pm", o.estimate.delta1_pm)?;
     d.set_item("delta2_pm", o.estimate.delta2_pm)?;
     d.set_item("force_n", o.estimate.force_n)?;
+    d.set_item("array_force_n", o.array_estimate_n.as_slice())?;
+    d.set_item("control_force_n", o.control_force_n)?;
     d.set_item("force_uncompensated_n", o.estimate.uncompensated_n)?;
     d.set_item("over_range", o.estimate.over_range)?;
     d.set_item("setpoint_n", o.setpoint_n)?;
