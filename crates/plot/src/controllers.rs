@@ -2,9 +2,10 @@
 //! grouped bars of the held rate and of the largest fluctuation while moving, one group per
 //! disturbance set and one bar per controller.
 
+use super::bar_axes::bar_axes;
 pub use super::controller_runs::{COLUMNS, ControllerRow, read};
 use super::controllers_summary::{GOAL_FLUCTUATION_PCT, SummaryRow, aggregate};
-use super::grid::{first_seen, index_label};
+use super::grid::first_seen;
 use super::style::{self, FONT};
 use super::{Chart, DrawResult, PlotError};
 use plotters::coord::Shift;
@@ -64,24 +65,7 @@ impl Controllers {
                 (format!("{object}: largest fluctuation while moving"), "bar: mean, tick: worst [%]")
             }
         };
-        let mut chart = ChartBuilder::on(area)
-            .caption(caption, (FONT, style::CAPTION))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
-            .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)?;
-        let sets = &self.sets;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n + 1)
-            .x_label_formatter(&|v| index_label(*v).and_then(|i| sets.get(i).cloned()).unwrap_or_default())
-            .y_desc(y_desc)
-            .y_labels(6)
-            .y_label_formatter(&|v| style::num(*v))
-            .axis_desc_style((FONT, style::AXIS))
-            .label_style((FONT, style::SMALL))
-            .draw()?;
+        let mut chart = bar_axes(area, caption, y_desc, &self.sets, top)?;
         let k = self.controllers.len().max(1) as f64;
         let width = 0.8 / k;
         for (ci, controller) in self.controllers.iter().enumerate() {

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+mod bar_axes;
 mod chart;
 mod error;
 mod path;

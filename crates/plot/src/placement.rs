@@ -2,7 +2,8 @@
 //! and the largest pad force of each sensor layout, one bar per condition (disturbance set ×
 //! feedback).
 
-use super::grid::{first_seen, index_label};
+use super::bar_axes::bar_axes;
+use super::grid::first_seen;
 use super::input::Table;
 use super::style::{self, FONT};
 use super::{Chart, DrawResult, PlotError};
@@ -101,24 +102,7 @@ impl Placement {
                 "mean over seeds [N]",
             ),
         };
-        let mut chart = ChartBuilder::on(area)
-            .caption(caption, (FONT, style::CAPTION))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
-            .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)?;
-        let layouts = &self.layouts;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n + 1)
-            .x_label_formatter(&|v| index_label(*v).and_then(|i| layouts.get(i).cloned()).unwrap_or_default())
-            .y_desc(y_desc)
-            .y_labels(6)
-            .y_label_formatter(&|v| style::num(*v))
-            .axis_desc_style((FONT, style::AXIS))
-            .label_style((FONT, style::SMALL))
-            .draw()?;
+        let mut chart = bar_axes(area, caption, y_desc, &self.layouts, top)?;
         let k = self.conditions.len().max(1) as f64;
         let width = 0.8 / k;
         for (ci, condition) in self.conditions.iter().enumerate() {
