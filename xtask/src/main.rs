@@ -35,11 +35,7 @@ fn main() -> ExitCode {
         "test" => fetch_mujoco().and_then(|_| run_tests(rest)),
         "layers" => check_layers(),
         "book" => build_book(rest),
-        "publish-check" => run(cargo()
-            .args(["publish", "--dry-run"])
-            .args(layers::published().flat_map(|p| ["--package", p]))
-            .args(rest)
-            .current_dir(workspace_root())),
+        "publish-check" => publish_check(rest),
         _ => {
             eprintln!("usage: cargo xtask <fetch|main|test|layers|book|publish-check> [extra cargo args]");
             return ExitCode::from(2);
@@ -227,6 +223,39 @@ fn check_layers() -> Result<(), String> {
         eprintln!("{e}");
     }
     Err(format!("{} rule(s) broken", errors.len()))
+}
+
+/// `cargo publish --dry-run` of the published crates, verifying each from its package alone.
+///
+/// A multi-package dry run hands the packages to each other through a local overlay registry,
+/// which cargo unpacks into `$CARGO_HOME/registry/src/-<hash of its path>/<crate>-<version>` and
+/// then reuses as long as that folder exists, whatever the package now holds. Our versions stay at
+/// 0.1.0 while the code changes, so a second run from the same checkout path (a CI machine that
+/// keeps `~/.cargo`) would verify against the old sources. Only those overlay folders (their
+/// registry has no host, so the name starts with `-`) of our own crates are removed first.
+fn publish_check(rest: &[String]) -> Result<(), String> {
+    let cargo_home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")))
+        .ok_or("neither CARGO_HOME nor HOME is set")?;
+    let src = cargo_home.join("registry/src");
+    for registry in std::fs::read_dir(&src).into_iter().flatten().flatten() {
+        if !registry.file_name().to_string_lossy().starts_with('-') {
+            continue;
+        }
+        for unpacked in std::fs::read_dir(registry.path()).into_iter().flatten().flatten() {
+            let name = unpacked.file_name().to_string_lossy().into_owned();
+            let ours = layers::published().any(|p| {
+                name.strip_prefix(p)
+                    .and_then(|v| v.strip_prefix('-'))
+                    .is_some_and(|v| v.starts_with(|c: char| c.is_ascii_digit()))
+            });
+            if ours {
+                std::fs::remove_dir_all(unpacked.path()).map_err(|e| format!("{}: {e}", unpacked.path().display()))?;
+            }
+        }
+    }
+    run(cargo().args(["publish", "--dry-run"]).args(layers::published().flat_map(|p| ["--package", p])).args(rest))
 }
 
 fn run(cmd: &mut Command) -> Result<(), String> {
