@@ -3,8 +3,7 @@
 
 use serde_json::Value;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 #[test]
 fn run_with_backend_rapier_names_it_in_the_summary() {

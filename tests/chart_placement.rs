@@ -6,8 +6,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 fn read(path: &Path) -> Vec<HashMap<String, String>> {
     let mut r = csv::Reader::from_path(path).unwrap();

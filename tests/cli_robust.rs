@@ -5,8 +5,7 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-use common::cli::{stderr, tendril, tendril_command};
+use crate::common::cli::{stderr, tendril, tendril_command};
 
 /// Short moves (the grasp is set per test).
 const SHORT: [&str; 8] =

@@ -4,8 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 /// A short pick-and-place (grasp 3 s, moves 1 s each) so the tests take a second, not a minute.
 const SHORT: [&str; 10] = [

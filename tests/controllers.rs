@@ -2,9 +2,7 @@
 //! (scenarios/short-lift.toml: crimper, 0.6 N, a 3 s grasp and a 3 s lift): both hold the object,
 //! and both grip harder than the paper's PID where their schedules say they should.
 
-mod common;
-
-use common::short_lift;
+use crate::common::short_lift;
 use tendril_control::task::Phase;
 use tendril_run::execute::run_on_twin;
 use tendril_run::runner::{Outcome, RunReport};

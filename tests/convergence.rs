@@ -5,8 +5,7 @@
 
 use std::collections::HashMap;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 type Rows = Vec<HashMap<String, String>>;
 

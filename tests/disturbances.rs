@@ -2,9 +2,7 @@
 //! short grasp-hold-lift (scenarios/short-lift.toml, ≈ 12 s of cell time, about a second of wall
 //! time), leaves the run untouched before it starts, and bad values are refused by key.
 
-mod common;
-
-use common::short_lift;
+use crate::common::short_lift;
 use std::path::Path;
 use tendril_config::ScenarioError;
 use tendril_control::task::Phase;
@@ -108,7 +106,7 @@ fn without_minimum_durations_the_lift_is_planned_at_the_limits() {
 }
 
 fn refused(overrides: &[&str]) -> (String, String) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(common::SHORT_LIFT);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(crate::common::SHORT_LIFT);
     let overrides: Vec<tendril_config::Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
     match tendril_config::load::<PickPlaceScenario>(&path, &overrides) {
         Err(ScenarioError::Invalid { key, reason, .. }) => (key, reason),

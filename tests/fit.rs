@@ -4,8 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::cli::{stderr, tendril, tendril_command};
+use crate::common::cli::{stderr, tendril, tendril_command};
 
 /// The short grasp-hold-lift (≈ 16 s of cell time, 0.3 s a run at [`QUICK_NUMERICS`]).
 const SCENARIO: &str = "scenarios/short-lift.toml";

@@ -2,8 +2,7 @@
 //! fit of the short lift writes its overlay (a scoped parameter as a comment) and a report whose
 //! objective and target residuals are those of real runs.
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 #[test]
 fn a_fit_to_targets_writes_its_overlay_and_report() {

@@ -12,8 +12,7 @@ use std::time::{Duration, Instant};
 use tendril_config::ScenarioError;
 use tendril_run::scenario::PickPlaceScenario;
 
-mod common;
-use common::cli::{stderr, tendril_command};
+use crate::common::cli::{stderr, tendril_command};
 
 /// The longest a single in-process mutant may take; a hang fails the test instead of blocking it.
 const LIMIT: Duration = Duration::from_secs(10);

@@ -3,9 +3,7 @@
 //! noise, the wrap phase ends with the pad actually touching. Before the detector averaged noisy
 //! readings, 10 pm ended 8 of 10 crimper closes with no contact and 30 pm all of them.
 
-mod common;
-
-use common::short_lift;
+use crate::common::short_lift;
 use tendril_control::task::Phase;
 use tendril_run::execute::run_on_twin;
 

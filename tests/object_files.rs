@@ -4,8 +4,7 @@
 
 use std::path::Path;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 /// A 250 g dowel on a round foot: the grip a 12.5 mm capsule of beech in a TPU wrap (μ 1.1).
 const DOWEL: &str = r#"<mujoco model="dowel">

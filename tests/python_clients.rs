@@ -12,8 +12,7 @@ use std::net::{IpAddr, Ipv4Addr};
 use std::process::Command;
 use tendril_serve::{ServeConfig, start};
 
-mod common;
-use common::{one_at_a_time, short_lift};
+use crate::common::{one_at_a_time, short_lift};
 
 fn python() -> Option<String> {
     match std::env::var("TENDRIL_PYTHON") {

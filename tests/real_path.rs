@@ -13,8 +13,7 @@ use tendril_run::runner::Outcome;
 use tendril_serve::jitter::Link;
 use tendril_serve::{Jitter, JitterModel, ServeConfig, ServeHandle, start};
 
-mod common;
-use common::{one_at_a_time, phases, short_lift};
+use crate::common::{one_at_a_time, phases, short_lift};
 
 #[test]
 fn real_path_against_virtual_devices_matches_the_twin() {

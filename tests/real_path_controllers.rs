@@ -8,8 +8,7 @@ use tendril_run::real::run_on_real;
 use tendril_run::runner::Outcome;
 use tendril_serve::{ServeConfig, start};
 
-mod common;
-use common::{one_at_a_time, phases, short_lift};
+use crate::common::{one_at_a_time, phases, short_lift};
 
 #[test]
 fn feedforward_and_slip_margin_run_on_the_real_path_as_on_the_twin() {

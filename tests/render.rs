@@ -8,8 +8,7 @@
 use std::io::Cursor;
 use std::path::Path;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 use tendril_twin::frames::{FRAMES_FILE, FrameLog};
 
 const WIDTH: usize = 160;

@@ -5,8 +5,7 @@
 
 use std::process::Command;
 
-mod common;
-use common::cli::{stderr, tendril};
+use crate::common::cli::{stderr, tendril};
 
 fn export(dir: &std::path::Path, scenario: &str, extra: &[&str]) -> std::path::PathBuf {
     let out = dir.join(format!("{}.xml", scenario.replace(['/', '.'], "_")));

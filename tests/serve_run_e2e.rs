@@ -19,9 +19,8 @@ use std::process::{Child, Command, Output, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-mod common;
-use common::cli::tendril_command;
-use common::{SHORT_LIFT, one_at_a_time, phases};
+use crate::common::cli::tendril_command;
+use crate::common::{SHORT_LIFT, one_at_a_time, phases};
 
 /// A running `tendril serve`, killed when dropped (also when the test fails).
 struct Server {

@@ -7,10 +7,9 @@ use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-use common::cli::{stderr, tendril_command};
+use crate::common::cli::{stderr, tendril_command};
 
-const SHORT_LIFT: &str = common::SHORT_LIFT;
+const SHORT_LIFT: &str = crate::common::SHORT_LIFT;
 
 /// `tendril view ARGS` with `display` as its only display (`None`: no display at all), killed
 /// after `limit`.
@@ -169,7 +168,7 @@ fn a_session_stepped_tick_by_tick_is_the_run_and_switches_feedback() {
     use tendril_run::session::{Action, Session};
     use tendril_twin::physics::SceneModel;
 
-    let scenario = common::short_lift(&["feedback=true"]);
+    let scenario = crate::common::short_lift(&["feedback=true"]);
     let plan = scenario.control_plan();
     let model = SceneModel::build(&scenario.scene_spec()).unwrap();
     let plain = run_task(&mut scenario.sim_cell(model.clone()), &plan);

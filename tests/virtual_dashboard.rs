@@ -11,8 +11,7 @@ use tendril_rtde::dashboard::RobotMode;
 use tendril_serve::{ProgramState, ServeConfig, ServeHandle, start};
 use tendril_urscript::FOLLOW_SCRIPT;
 
-mod common;
-use common::{one_at_a_time, short_lift};
+use crate::common::{one_at_a_time, short_lift};
 
 /// A line-oriented dashboard client on a plain socket.
 struct Dashboard {

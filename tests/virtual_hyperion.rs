@@ -9,8 +9,7 @@ use tendril_codec::Decoded;
 use tendril_hyperion::{PeakFrame, Request, Response, decode_stream_frame};
 use tendril_serve::{ServeConfig, start};
 
-mod common;
-use common::{one_at_a_time, short_lift};
+use crate::common::{one_at_a_time, short_lift};
 
 /// Every frame the stream sends for `seconds`.
 fn stream_for(addr: SocketAddr, seconds: f64) -> Vec<PeakFrame> {

@@ -12,8 +12,7 @@ use tendril_serve::{ServeConfig, ServeHandle, start};
 use tendril_ur5e::pose::tcp_pose;
 use tendril_urscript::{FOLLOW_SCRIPT, input_names};
 
-mod common;
-use common::{one_at_a_time, short_lift};
+use crate::common::{one_at_a_time, short_lift};
 
 /// A blocking RTDE client on a plain socket.
 struct Rtde {
