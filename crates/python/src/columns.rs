@@ -4,7 +4,7 @@
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use tendril_run::trace::TraceRow;
+use tendril_run::trace::{TraceRow, array_columns};
 
 /// How a column is read from a row.
 enum Column {
@@ -42,22 +42,12 @@ pub fn names() -> Vec<&'static str> {
     COLUMNS.iter().map(|(name, _)| *name).collect()
 }
 
-/// A sensor array's columns of a row, in `trace.csv`'s order and names: each further pad's true
+/// A sensor array's values of a row, in the order of [`array_columns`]: each further pad's true
 /// force, peaks and estimate, then the force the controller regulated (none without an array).
-fn array_cells(r: &TraceRow) -> Vec<(String, f64)> {
+fn array_values(r: &TraceRow) -> impl Iterator<Item = f64> + '_ {
     let pads = r.array.pads.as_slice();
-    let mut out = Vec::with_capacity(4 * pads.len() + 1);
-    for (i, p) in pads.iter().enumerate() {
-        let k = i + 1;
-        out.push((format!("pad{k}_true_force_n"), p.true_force_n));
-        out.push((format!("pad{k}_fbg1_nm"), p.fbg1_nm));
-        out.push((format!("pad{k}_fbg2_nm"), p.fbg2_nm));
-        out.push((format!("pad{k}_force_n"), p.force_n));
-    }
-    if !pads.is_empty() {
-        out.push(("control_force_n".to_string(), r.array.control_force_n));
-    }
-    out
+    let control = (!pads.is_empty()).then_some(r.array.control_force_n);
+    pads.iter().flat_map(|p| [p.true_force_n, p.fbg1_nm, p.fbg2_nm, p.force_n]).chain(control)
 }
 
 /// Every column of `rows` as `(name, kind, data)`: kind `"f8"` with little-endian float64
@@ -82,10 +72,10 @@ pub fn columns<'py>(py: Python<'py>, rows: &[TraceRow]) -> PyResult<Vec<(String,
             })
         })
         .collect::<PyResult<Vec<_>>>()?;
-    let names: Vec<String> = rows.first().map(array_cells).unwrap_or_default().into_iter().map(|(n, _)| n).collect();
+    let names = array_columns(rows.first().map_or(0, |r| r.array.pads.len()));
     let mut data: Vec<Vec<u8>> = vec![Vec::with_capacity(8 * rows.len()); names.len()];
     for r in rows {
-        for (bytes, (_, value)) in data.iter_mut().zip(array_cells(r)) {
+        for (bytes, value) in data.iter_mut().zip(array_values(r)) {
             bytes.extend_from_slice(&value.to_le_bytes());
         }
     }
@@ -105,7 +95,7 @@ pub fn row_dict<'py>(py: Python<'py>, r: &TraceRow) -> PyResult<Bound<'py, PyDic
             Column::Phase => d.set_item(name, r.phase.name())?,
         }
     }
-    for (name, value) in array_cells(r) {
+    for (name, value) in array_columns(r.array.pads.len()).into_iter().zip(array_values(r)) {
         d.set_item(name, value)?;
     }
     Ok(d)

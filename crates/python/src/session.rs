@@ -100,8 +100,8 @@ impl Session {
     /// `time_s`, `phase`, `phase_index`, `fbg1_nm`, `fbg2_nm`, `delta1_pm` and `delta2_pm` (the
     /// gratings' shifts from the tare), `force_n`, `array_force_n` (a sensor array's further pads'
     /// estimates, empty without one), `control_force_n` (what the controller regulates),
-    /// `force_uncompensated_n`, `over_range`, `setpoint_n`, `time_to_motion_s`, `arm_q_rad`, `growth_motor_rad`, `twine_motor_rad`,
-    /// `tool_load_n` and `truth` (the ground truth: `sensor_force_n`, `grip_force_n`,
+    /// `force_uncompensated_n`, `over_range`, `setpoint_n`, `time_to_motion_s`, `arm_q_rad`,
+    /// `growth_motor_rad`, `twine_motor_rad`, `tool_load_n` and `truth` (the ground truth: `sensor_force_n`, `grip_force_n`,
     /// `object_height_m`, `slip_speed_m_s`, `in_contact`).
     fn observation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let seen = self.lock().session.as_ref().and_then(|s| s.observation());

@@ -112,6 +112,20 @@ tool_load_n";
 /// at 100 Hz), what a `BufWriter` holds, so a process killed outright loses as little as before.
 const BUFFER_BYTES: usize = 8 * 1024;
 
+/// The columns a sensor array adds after those of every trace, for `further_pads` pads beyond
+/// pad 0: each pad's true force, peaks and estimate (`pad{k}_true_force_n`, `pad{k}_fbg1_nm`, `pad{k}_fbg2_nm`,
+/// `pad{k}_force_n`, k from 1), then `control_force_n`, the force the controller regulated; none
+/// without an array. A row's values are in the same order ([`TraceWriter::write`]).
+pub fn array_columns(further_pads: usize) -> Vec<String> {
+    let mut names: Vec<String> = (1..=further_pads)
+        .flat_map(|k| ["true_force_n", "fbg1_nm", "fbg2_nm", "force_n"].map(|q| format!("pad{k}_{q}")))
+        .collect();
+    if further_pads > 0 {
+        names.push("control_force_n".into());
+    }
+    names
+}
+
 /// Streams rows to a CSV file; rows already written survive a failed run. Rows are collected
 /// whole and written in whole rows only; if a write fails (a full disk) the file is cut back to
 /// the rows written before, so it always ends between rows. The first write error is kept
@@ -172,11 +186,8 @@ impl TraceWriter {
         if !self.header {
             self.header = true;
             self.buffer.extend_from_slice(HEADER.as_bytes());
-            for k in 1..=r.array.pads.len() {
-                write!(self.buffer, ",pad{k}_true_force_n,pad{k}_fbg1_nm,pad{k}_fbg2_nm,pad{k}_force_n")?;
-            }
-            if !r.array.pads.is_empty() {
-                self.buffer.extend_from_slice(b",control_force_n");
+            for name in array_columns(r.array.pads.len()) {
+                write!(self.buffer, ",{name}")?;
             }
             self.buffer.push(b'\n');
         }
