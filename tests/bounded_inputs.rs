@@ -84,6 +84,16 @@ fn a_graded_finger_finer_than_its_bound_names_the_refinement_and_the_way_out() {
 }
 
 #[test]
+fn a_fine_zone_must_start_on_the_strip_before_the_pad() {
+    for bad in ["-0.01", "0.06", "nan"] {
+        assert_eq!(key_of(&[&format!("finger.fine_from_m={bad}")]), "finger.fine_from_m", "{bad}");
+    }
+    let err = load(&["finger.fine_from_m=0.06"]).unwrap_err().to_string();
+    assert!(err.contains("before the pad's casing") && err.contains("0.05525"), "{err}");
+    assert!(load(&["finger.fine_from_m=0.0175"]).is_ok());
+}
+
+#[test]
 fn any_u64_seed_is_accepted_through_set_and_the_file() {
     assert_eq!(load(&["seed=18446744073709551615"]).unwrap().seed, u64::MAX);
     assert_eq!(load(&["seed=\"18446744073709551615\""]).unwrap().seed, u64::MAX);

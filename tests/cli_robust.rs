@@ -170,6 +170,45 @@ fn unbounded_arguments_are_refused_at_once() {
     }
 }
 
+/// The gain map's grid and overrides come from the command line: the grid given is the grid run,
+/// and a gain or an override the bounds refuse is named before anything runs.
+#[test]
+fn the_gain_map_runs_the_grid_and_overrides_it_is_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().to_str().unwrap();
+    let mut args = vec![
+        "chart",
+        "gain-map",
+        "--scenario",
+        "scenarios/crimper.toml",
+        "--kp",
+        "10,20",
+        "--ki",
+        "0.05",
+        "--threads",
+        "2",
+        "--out",
+        out_dir,
+        "--set",
+        "task.grasp_s=1",
+        "--set",
+        "task.minimum_durations=false",
+    ];
+    args.extend(SHORT);
+    let out = tendril(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = std::fs::read_to_string(dir.path().join("gain_map.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert!(rows[0].starts_with("crimper,10,0.05,") && rows[1].starts_with("crimper,20,0.05,"), "{csv}");
+    let refused = tendril(&["chart", "gain-map", "--kp=-1", "--out", out_dir]);
+    assert!(!refused.status.success());
+    assert!(stderr(&refused).contains("controller.kp"), "{}", stderr(&refused));
+    let refused = tendril(&["chart", "gain-map", "--set", "task.grasp_s=-1", "--out", out_dir]);
+    assert!(!refused.status.success());
+    assert!(stderr(&refused).contains("task.grasp_s"), "{}", stderr(&refused));
+}
+
 /// A missing file is named once with its reason, not with the reason repeated as its cause.
 #[test]
 fn a_missing_scenario_says_why_once() {

@@ -285,6 +285,33 @@ mujoco,implicitfast,elliptic,newton,0.00125,8,8,20,0.009,0.2,ok,false,false
     assert!(svg.contains("8 links (base x8)"), "the front's graded point is labelled with its grading");
 }
 
+/// A finger whose fine links start above the base (`fine_from_m`) is read and labelled with where
+/// they start; a file without the column reads as fine from the base.
+#[test]
+fn speed_accuracy_chart_labels_a_fine_zone() {
+    let (_keep, dir) = workdir("speed-zone");
+    let csv = "backend,integrator,cone,solver,timestep_s,segments,base_refinement,fine_from_m,sim_s_per_cpu_s,force_rmse_n,drop_time_error_s,status,is_default,is_reference
+mujoco,implicitfast,elliptic,newton,0.0003125,256,1,0,0.1,0,0,ok,false,true
+mujoco,implicitfast,elliptic,newton,0.0025,8,8,0,40,0.014,0.4,ok,true,false
+mujoco,implicitfast,elliptic,newton,0.0025,8,8,0.0175,50,0.012,3.3,ok,false,false
+";
+    std::fs::write(dir.join("speed_accuracy.csv"), csv).unwrap();
+    let rows = plot::speed_accuracy::read(&dir.join("speed_accuracy.csv")).unwrap();
+    assert_eq!((rows[1].fine_from_m, rows[2].fine_from_m), (0.0, 0.0175));
+    assert_eq!(plot::speed_accuracy::pareto_front(&rows), vec![2]);
+    plot::speed_accuracy::render(&rows, &dir).unwrap();
+    let svg = std::fs::read_to_string(dir.join("speed_accuracy.svg")).unwrap();
+    assert!(svg.contains("8 links (base x8 from 17.5 mm)"), "the front's zoned point names its zone");
+    let without = csv
+        .replace(",fine_from_m", "")
+        .replace(",8,8,0,", ",8,8,")
+        .replace(",8,8,0.0175,", ",8,8,")
+        .replace(",256,1,0,", ",256,1,");
+    std::fs::write(dir.join("speed_accuracy.csv"), without).unwrap();
+    let rows = plot::speed_accuracy::read(&dir.join("speed_accuracy.csv")).unwrap();
+    assert!(rows.iter().all(|r| r.fine_from_m == 0.0));
+}
+
 #[test]
 fn stability_chart_marks_largest_stable() {
     let (_keep, dir) = workdir("stability");

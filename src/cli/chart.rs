@@ -41,9 +41,16 @@ pub struct ChartArgs {
     /// [default: 0.000625, the "down to at least 0.625 ms"; at most that, at least 1e-5].
     #[arg(long, value_name = "SECONDS")]
     finest_step: Option<f64>,
-    /// Convergence: override a scenario value in every run: `--set key.path=value` (repeatable).
+    /// Convergence and gain-map: override a scenario value in every run: `--set key.path=value`
+    /// (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<tendril_config::Override>,
+    /// Gain map: the Kp values \[(°/s)/N\] [default: 2,5,10,20,50,100,200; with --quick 5,20].
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    kp: Vec<f64>,
+    /// Gain map: the Ki values \[(°/s)/(N·s)\] [default: 0,0.05,0.5,5,50; with --quick 0.05].
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    ki: Vec<f64>,
 }
 
 /// The three objects' scenarios, or the ones given.
@@ -71,7 +78,7 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             let grid = if a.quick { study::speed_accuracy::Grid::quick() } else { study::speed_accuracy::Grid::full() };
             let p = PhysicsConfig::default();
             let f = FingerConfig::default();
-            let defaults = (p.timestep_s, "implicitfast", "elliptic", f.segments, f.base_refinement);
+            let defaults = (p.timestep_s, "implicitfast", "elliptic", f.segments, f.base_refinement, f.fine_from_m);
             study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, defaults, &out, a.threads)?
         }
         "stability" => {
@@ -82,7 +89,9 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             let scenarios = objects_or(&a.scenario);
             let (kp, ki): (&[f64], &[f64]) =
                 if a.quick { (&[5.0, 20.0], &[0.05]) } else { (&study::gain_map::KP, &study::gain_map::KI) };
-            study::gain_map::run(&scenarios, kp, ki, &out, a.threads)?
+            let kp = if a.kp.is_empty() { kp } else { &a.kp };
+            let ki = if a.ki.is_empty() { ki } else { &a.ki };
+            study::gain_map::run(&scenarios, kp, ki, &a.set, &out, a.threads)?
         }
         "controllers" => controllers(&a, &out)?,
         "placement" => {

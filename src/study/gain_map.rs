@@ -10,14 +10,25 @@ pub const KP: [f64; 7] = [2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0];
 /// Ki values tried [(°/s)/(N·s)]: from none through the paper's 0.05 to strongly integral.
 pub const KI: [f64; 5] = [0.0, 0.05, 0.5, 5.0, 50.0];
 
-/// Runs the map for each scenario, writes `gain_map.csv` and a chart per object into `out`.
-pub fn run(scenarios: &[PathBuf], kp: &[f64], ki: &[f64], out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
+/// Runs the map for each scenario, with `extra` applied to every run before the gains, writes
+/// `gain_map.csv` and a chart per object into `out`. A gain the scenario's bounds refuse is an
+/// error naming the key before anything runs.
+pub fn run(
+    scenarios: &[PathBuf],
+    kp: &[f64],
+    ki: &[f64],
+    extra: &[tendril_config::Override],
+    out: &Path,
+    threads: usize,
+) -> anyhow::Result<Vec<PathBuf>> {
     let mut rows = Vec::new();
     for scenario in scenarios {
         let mut sets = Vec::new();
         for &p in kp {
             for &i in ki {
-                sets.push(vec![set("controller.kp", p), set("controller.ki", i), set("feedback", true)]);
+                let mut overrides = extra.to_vec();
+                overrides.extend([set("controller.kp", p), set("controller.ki", i), set("feedback", true)]);
+                sets.push(overrides);
             }
         }
         for r in run_all(scenario, sets, threads)? {

@@ -35,9 +35,10 @@ pub struct Grid {
     /// The reference: timestep \[s\] and links (MuJoCo, implicitfast, elliptic cone: the finest
     /// setting of the convergence study, where the integrators agree).
     pub reference: (f64, u32),
-    /// Graded fingers (links, `finger.base_refinement`) run at every MuJoCo timestep with
-    /// implicitfast and elliptic cones: the strip cut finer only between its base and the pad.
-    pub graded: Vec<(u32, u32)>,
+    /// Graded fingers (links, `finger.base_refinement`, `finger.fine_from_m` \[m\]) run at every
+    /// MuJoCo timestep with implicitfast and elliptic cones: the strip cut finer only between its
+    /// base (or `fine_from_m`) and the pad.
+    pub graded: Vec<(u32, u32, f64)>,
     /// Other MuJoCo constraint solvers (`physics.solver`) run at every MuJoCo timestep with
     /// implicitfast, elliptic cones and each of `segments`.
     pub solvers: Vec<&'static str>,
@@ -58,7 +59,9 @@ impl Grid {
             rapier_timesteps_s: vec![0.0025, 0.005],
             rapier_segments: vec![32],
             reference: (0.0003125, 256),
-            graded: vec![(8, 8), (16, 8), (16, 4), (32, 2)],
+            // The last: the default with its first 17.5 mm as one coarse link (issue 39's lever 2,
+            // fine links only where objects touch; docs/studies/levers.md).
+            graded: vec![(8, 8, 0.0), (16, 8, 0.0), (16, 4, 0.0), (32, 2, 0.0), (8, 8, 0.0175)],
             solvers: vec!["cg"],
         }
     }
@@ -74,7 +77,7 @@ impl Grid {
             rapier_timesteps_s: vec![0.002, 0.005],
             rapier_segments: vec![16],
             reference: (0.0025, 32),
-            graded: vec![(8, 2)],
+            graded: vec![(8, 2, 0.0)],
             solvers: vec![],
         }
     }
@@ -89,6 +92,7 @@ struct Point {
     cone: String,
     segments: u32,
     base_refinement: u32,
+    fine_from_m: f64,
     solver: &'static str,
     rapier_iterations: Option<u32>,
 }
@@ -101,6 +105,7 @@ impl Point {
             cone: cone.into(),
             segments,
             base_refinement: 1,
+            fine_from_m: 0.0,
             solver: "newton",
             rapier_iterations: None,
         }
@@ -113,6 +118,7 @@ impl Point {
             cone: "coulomb".into(),
             segments,
             base_refinement: 1,
+            fine_from_m: 0.0,
             solver: "pgs",
             rapier_iterations: Some(iterations),
         }
@@ -123,6 +129,7 @@ impl Point {
             set("physics.timestep_s", self.timestep_s),
             set("finger.segments", self.segments),
             set("finger.base_refinement", self.base_refinement),
+            set("finger.fine_from_m", self.fine_from_m),
             set("feedback", false),
         ];
         match self.rapier_iterations {
@@ -139,11 +146,11 @@ impl Point {
 
 /// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`.
 /// `defaults` names the project's default settings (timestep, integrator, cone, links,
-/// base refinement) to highlight; `threads` runs at once (speed is each run's own CPU time). Returns the files written.
+/// base refinement, fine grid's start \[m\]) to highlight; `threads` runs at once (speed is each run's own CPU time). Returns the files written.
 pub fn run(
     scenario: &Path,
     grid: &Grid,
-    defaults: (f64, &str, &str, u32, u32),
+    defaults: (f64, &str, &str, u32, u32, f64),
     out: &Path,
     threads: usize,
 ) -> anyhow::Result<Vec<PathBuf>> {
@@ -162,12 +169,19 @@ pub fn run(
                 labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
             }
         }
-        for &(segments, base_refinement) in &grid.graded {
-            labels.push(Point { base_refinement, ..Point::mujoco(dt, "implicitfast", "elliptic", segments) });
+        for &(segments, base_refinement, fine_from_m) in &grid.graded {
+            labels.push(Point {
+                base_refinement,
+                fine_from_m,
+                ..Point::mujoco(dt, "implicitfast", "elliptic", segments)
+            });
         }
     }
-    let default =
-        Point { base_refinement: defaults.4, ..Point::mujoco(defaults.0, defaults.1, defaults.2, defaults.3) };
+    let default = Point {
+        base_refinement: defaults.4,
+        fine_from_m: defaults.5,
+        ..Point::mujoco(defaults.0, defaults.1, defaults.2, defaults.3)
+    };
     let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), threads)?;
     let reference = &runs[0];
     let rows: Vec<SpeedAccuracyRow> = runs
@@ -188,6 +202,7 @@ pub fn run(
                 timestep_s: point.timestep_s,
                 segments: point.segments,
                 base_refinement: point.base_refinement,
+                fine_from_m: point.fine_from_m,
                 sim_s_per_cpu_s: ok.then_some(r.summary.sim_s_per_cpu_s),
                 force_rmse_n: if i == 0 {
                     Some(0.0)
@@ -213,6 +228,7 @@ pub fn run(
         "timestep_s",
         "segments",
         "base_refinement",
+        "fine_from_m",
         "sim_s_per_cpu_s",
         "force_rmse_n",
         "drop_time_error_s",
@@ -231,6 +247,7 @@ pub fn run(
                 r.timestep_s.to_string(),
                 r.segments.to_string(),
                 r.base_refinement.to_string(),
+                r.fine_from_m.to_string(),
                 cell(r.sim_s_per_cpu_s),
                 cell(r.force_rmse_n),
                 cell(r.drop_time_error_s),

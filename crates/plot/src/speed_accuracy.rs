@@ -28,6 +28,9 @@ pub struct SpeedAccuracyRow {
     pub segments: u32,
     /// `finger.base_refinement` (1, a uniform strip, when the file has no such column).
     pub base_refinement: u32,
+    /// `finger.fine_from_m` \[m\]: where the base stretch's finer links start (0, from the base,
+    /// when the file has no such column).
+    pub fine_from_m: f64,
     /// Simulated seconds per CPU second of the run's thread (None if the run failed before measuring).
     pub sim_s_per_cpu_s: Option<f64>,
     /// RMSE of the sensor force against the reference run \[N\].
@@ -52,6 +55,7 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
         (c("sim_s_per_cpu_s")?, c("force_rmse_n")?, c("drop_time_error_s")?, c("status")?);
     let (default, reference) = (c("is_default")?, c("is_reference")?);
     let (solver, refinement) = (t.optional_column("solver"), t.optional_column("base_refinement"));
+    let fine_from = t.optional_column("fine_from_m");
     let rows = t
         .iter()
         .map(|r| {
@@ -66,6 +70,10 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
                 base_refinement: match refinement {
                     Some(c) => whole(&r, "base_refinement", r.text(c))?,
                     None => 1,
+                },
+                fine_from_m: match fine_from {
+                    Some(c) => r.f64(c)?,
+                    None => 0.0,
                 },
                 sim_s_per_cpu_s: r.opt_f64(speed)?,
                 force_rmse_n: r.opt_f64(rmse)?,
@@ -129,7 +137,11 @@ fn series(r: &SpeedAccuracyRow) -> String {
 
 /// Short description of a row's settings, for labels.
 fn settings(r: &SpeedAccuracyRow) -> String {
-    let graded = if r.base_refinement > 1 { format!(" (base x{})", r.base_refinement) } else { String::new() };
+    let graded = match (r.base_refinement > 1, r.fine_from_m > 0.0) {
+        (true, true) => format!(" (base x{} from {:.1} mm)", r.base_refinement, r.fine_from_m * 1e3),
+        (true, false) => format!(" (base x{})", r.base_refinement),
+        _ => String::new(),
+    };
     format!("{}, {} links{graded}, {}", style::timestep(r.timestep_s), r.segments, r.cone)
 }
 

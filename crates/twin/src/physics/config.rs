@@ -398,6 +398,14 @@ pub struct FingerConfig {
     /// there, while the distal stretch, whose loads change slowly, keeps coarse ones. Doubling
     /// `segments` halves both grids.
     pub base_refinement: u32,
+    /// Arc length from the strip's base where the fine grid of `base_refinement` starts \[m\]; the
+    /// strip below it keeps the coarse links of `segments`. 0 (the default): the fine grid runs
+    /// from the base to the pad. A numerical choice, like `base_refinement`, and one that does
+    /// not pay on the paper's objects: nothing touches their strip's first 22 mm, but it bends
+    /// there by about 30 rad/m, and coarse links there (from 17.5 mm, or 8.75 mm links below it)
+    /// moved every drop by 1.2-3.3 s (docs/studies/levers.md, lever 2). Check any other value with
+    /// `tendril chart convergence --quick --set finger.fine_from_m=...`.
+    pub fine_from_m: f64,
     /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
     /// Strip thickness \[m\] (capsule diameter). 2 mm: a choice for a TPU strip with a tendon channel.
@@ -506,6 +514,7 @@ impl Default for FingerConfig {
         FingerConfig {
             segments: 8,
             base_refinement: 8,
+            fine_from_m: 0.0,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,
@@ -561,6 +570,14 @@ impl Validate for FingerConfig {
             )
         });
         at.in_range("length_m", self.length_m, 0.02, 0.5);
+        // The fine grid must keep at least its first link before the pad's casing.
+        at.require("fine_from_m", self.fine_from_m >= 0.0 && self.fine_from_m < self.pad_position_m - 0.006, || {
+            format!(
+                "must be at least 0 and before the pad's casing (pad_position_m - 0.006 = {} m), got {}",
+                self.pad_position_m - 0.006,
+                self.fine_from_m
+            )
+        });
         at.in_range("thickness_m", self.thickness_m, 2e-4, 0.02);
         at.positive("width_m", self.width_m);
         at.positive("density_kg_m3", self.density_kg_m3);

@@ -53,11 +53,19 @@ pub fn layout_with_pads(f: &FingerConfig, extra_pads_m: &[f64]) -> Vec<Piece> {
     let mut edges: Vec<f64> = pads.iter().flat_map(|&(a, b)| [a, b]).collect();
     edges.push(tip);
     let inside_fixed = |s: f64| pads.iter().any(|&(a, b)| s > a && s < b) || s > tip;
-    // The base stretch (up to the pad's casing) on its finer grid, the rest on the uniform one; a
-    // grid point closer than half its own link to a fixed edge is dropped.
+    // The base stretch (up to the pad's casing) on its finer grid from `fine_from_m` on, the rest
+    // on the uniform one; a grid point closer than half its own link to a fixed edge is dropped, and
+    // a coarse point closer than half a fine link to the fine grid's start (no slivers there either).
     let base_l = l / f64::from(f.base_refinement.max(1));
-    let base_grid = (1..).map(|i| f64::from(i) * base_l).take_while(|&s| s < pad.0).map(|s| (s, base_l));
-    let rest_grid = (1..f.segments).map(|i| (f64::from(i) * l, l)).filter(|&(s, _)| s > pad.0);
+    let fine_from = f.fine_from_m.max(0.0);
+    let base_grid = (1..)
+        .map(|i| f64::from(i) * base_l)
+        .take_while(|&s| s < pad.0)
+        .filter(|&s| s >= fine_from - 1e-12)
+        .map(|s| (s, base_l));
+    let first_fine = (fine_from / base_l - 1e-9).ceil().max(1.0) * base_l;
+    let rest_grid =
+        (1..f.segments).map(|i| (f64::from(i) * l, l)).filter(|&(s, _)| s > pad.0 || s < first_fine - base_l / 2.0);
     let mut cuts: Vec<f64> = base_grid
         .chain(rest_grid)
         .filter(|&(s, h)| !inside_fixed(s) && edges.iter().all(|e| (s - e).abs() >= h / 2.0 - 1e-12))
@@ -138,6 +146,42 @@ mod tests {
         }
         let total: f64 = refined.iter().map(|p| p.length_m).sum();
         assert!((total - f.length_m).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_fine_zone_keeps_the_coarse_links_below_it_and_the_fine_ones_from_it_to_the_pad() {
+        let graded = FingerConfig::default();
+        let l = graded.segment_length_m();
+        let h = l / f64::from(graded.base_refinement);
+        let pad_start = graded.pad_position_m - PAD_HALF_LENGTH_M;
+        for fine_from in [l, 0.02, 0.03] {
+            let f = FingerConfig { fine_from_m: fine_from, ..graded.clone() };
+            let zoned = layout(&f);
+            let total: f64 = zoned.iter().map(|p| p.length_m).sum();
+            assert!((total - f.length_m).abs() < 1e-12, "{fine_from}");
+            let first_fine = (fine_from / h - 1e-9).ceil() * h;
+            for p in zoned.iter().filter(|p| !p.fixed && p.start_m < pad_start - 1e-12) {
+                if p.start_m >= first_fine - 1e-12 {
+                    assert!(p.length_m >= h / 2.0 - 1e-12 && p.length_m < 1.5 * h + 1e-12, "{fine_from}: {p:?}");
+                } else {
+                    assert!(p.length_m >= h / 2.0 - 1e-12 && p.length_m <= l + 1e-12, "{fine_from}: {p:?}");
+                }
+            }
+            let from_zone = |p: &[Piece]| {
+                p.iter()
+                    .filter(|x| x.start_m >= first_fine - 1e-12)
+                    .map(|x| (x.start_m, x.length_m))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(
+                from_zone(&zoned),
+                from_zone(&layout(&graded)),
+                "{fine_from}: the zone and beyond are the graded finger's"
+            );
+            assert!(zoned.len() < layout(&graded).len(), "{fine_from}");
+        }
+        // One coarse link in place of the first eight fine ones at 17.5 mm: 23 bodies against 30.
+        assert_eq!(layout(&FingerConfig { fine_from_m: l, ..graded }).len(), 23);
     }
 
     #[test]
