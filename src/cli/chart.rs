@@ -4,7 +4,7 @@ use super::emit;
 use crate::study;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use tendril_twin::physics::{Backend, FingerConfig, PhysicsConfig};
+use tendril_twin::physics::Backend;
 
 /// Arguments of `tendril chart`.
 #[derive(Debug, clap::Args)]
@@ -76,10 +76,7 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
         }
         "speed-accuracy" => {
             let grid = if a.quick { study::speed_accuracy::Grid::quick() } else { study::speed_accuracy::Grid::full() };
-            let p = PhysicsConfig::default();
-            let f = FingerConfig::default();
-            let defaults = (p.timestep_s, "implicitfast", "elliptic", f.segments, f.base_refinement, f.fine_from_m);
-            study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, defaults, &out, a.threads)?
+            study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, &out, a.threads)?
         }
         "stability" => {
             let steps: &[f64] = if a.quick { &[0.005, 0.04] } else { &study::stability::TIMESTEPS_S };

@@ -12,6 +12,7 @@ use super::convergence::force_rmse;
 use super::{cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
 use tendril_plot::speed_accuracy::{SpeedAccuracyRow, render};
+use tendril_twin::physics::{FingerConfig, PhysicsConfig};
 
 /// The grid of a speed/accuracy study.
 #[derive(Debug, Clone)]
@@ -111,6 +112,17 @@ impl Point {
         }
     }
 
+    /// The project's default settings (`PhysicsConfig` and `FingerConfig` defaults: implicitfast,
+    /// elliptic cones, Newton).
+    fn project_default() -> Point {
+        let (p, f) = (PhysicsConfig::default(), FingerConfig::default());
+        Point {
+            base_refinement: f.base_refinement,
+            fine_from_m: f.fine_from_m,
+            ..Point::mujoco(p.timestep_s, "implicitfast", "elliptic", f.segments)
+        }
+    }
+
     fn rapier(timestep_s: f64, iterations: u32, segments: u32) -> Point {
         Point {
             timestep_s,
@@ -144,16 +156,10 @@ impl Point {
     }
 }
 
-/// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`.
-/// `defaults` names the project's default settings (timestep, integrator, cone, links,
-/// base refinement, fine grid's start \[m\]) to highlight; `threads` runs at once (speed is each run's own CPU time). Returns the files written.
-pub fn run(
-    scenario: &Path,
-    grid: &Grid,
-    defaults: (f64, &str, &str, u32, u32, f64),
-    out: &Path,
-    threads: usize,
-) -> anyhow::Result<Vec<PathBuf>> {
+/// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`, the
+/// project's default settings ringed; `threads` runs at once (speed is each run's own CPU time).
+/// Returns the files written.
+pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
     let mut labels = vec![Point::mujoco(grid.reference.0, "implicitfast", "elliptic", grid.reference.1)];
     for &dt in &grid.timesteps_s {
         for &segments in &grid.segments {
@@ -177,11 +183,7 @@ pub fn run(
             });
         }
     }
-    let default = Point {
-        base_refinement: defaults.4,
-        fine_from_m: defaults.5,
-        ..Point::mujoco(defaults.0, defaults.1, defaults.2, defaults.3)
-    };
+    let default = Point::project_default();
     let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), threads)?;
     let reference = &runs[0];
     let rows: Vec<SpeedAccuracyRow> = runs

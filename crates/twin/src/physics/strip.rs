@@ -57,13 +57,12 @@ pub fn layout_with_pads(f: &FingerConfig, extra_pads_m: &[f64]) -> Vec<Piece> {
     // on the uniform one; a grid point closer than half its own link to a fixed edge is dropped, and
     // a coarse point closer than half a fine link to the fine grid's start (no slivers there either).
     let base_l = l / f64::from(f.base_refinement.max(1));
-    let fine_from = f.fine_from_m.max(0.0);
+    let first_fine = (f.fine_from_m.max(0.0) / base_l - 1e-9).ceil().max(1.0) * base_l;
     let base_grid = (1..)
         .map(|i| f64::from(i) * base_l)
         .take_while(|&s| s < pad.0)
-        .filter(|&s| s >= fine_from - 1e-12)
+        .filter(|&s| s >= first_fine - 1e-12)
         .map(|s| (s, base_l));
-    let first_fine = (fine_from / base_l - 1e-9).ceil().max(1.0) * base_l;
     let rest_grid =
         (1..f.segments).map(|i| (f64::from(i) * l, l)).filter(|&(s, _)| s > pad.0 || s < first_fine - base_l / 2.0);
     let mut cuts: Vec<f64> = base_grid
