@@ -78,6 +78,26 @@ impl SharedInputs {
         std::mem::take(&mut self.io_packages)
     }
 
+    /// Applies one input data package, its fields by name: their values, their write counts, and
+    /// its IO fields for [`SharedInputs::take_io_packages`].
+    pub fn apply_package<'a>(&mut self, fields: impl IntoIterator<Item = (&'a str, RtdeValue)>) {
+        let mut io = Vec::new();
+        for (name, value) in fields {
+            if is_io_input(name) {
+                io.push((name.to_string(), value));
+            }
+            self.values.apply(name, value);
+            *self.writes.entry(name.to_string()).or_insert(0) += 1;
+        }
+        if !io.is_empty() {
+            if self.io_packages.len() >= MAX_IO_PACKAGES {
+                self.io_packages.remove(0);
+            }
+            self.io_packages.push(io);
+        }
+        self.packages += 1;
+    }
+
     /// Frees the inputs claimed by a closed connection.
     pub fn release(&mut self, session: u64) {
         self.owners.retain(|_, owner| *owner != session);
@@ -252,24 +272,7 @@ impl ServerSession {
         // Applied whether or not the session was started: SDU ur_rtde's RTDEIOInterface sets up
         // its input recipes and sends data packages without ever sending START, and works on real
         // controllers, so they take inputs from a session that has not started.
-        let io: Vec<(String, RtdeValue)> =
-            recipe.names.iter().zip(&values).filter(|(n, _)| is_io_input(n)).map(|(n, v)| (n.clone(), *v)).collect();
-        if !io.is_empty() {
-            if shared.io_packages.len() >= MAX_IO_PACKAGES {
-                shared.io_packages.remove(0);
-            }
-            shared.io_packages.push(io);
-        }
-        for (name, value) in recipe.names.iter().zip(values) {
-            shared.values.apply(name, value);
-            match shared.writes.get_mut(name) {
-                Some(n) => *n += 1,
-                None => {
-                    shared.writes.insert(name.clone(), 1);
-                }
-            }
-        }
-        shared.packages += 1;
+        shared.apply_package(recipe.names.iter().map(String::as_str).zip(values));
         Ok(())
     }
 

@@ -80,7 +80,7 @@ pub struct Jitter {
     pub model: JitterModel,
     /// Seed [-].
     pub seed: u64,
-    /// Only this link (`None`: every link).
+    /// Only this link (`None`: every link of the devices, [`Link::Twin`] not included).
     pub only: Option<Link>,
 }
 
@@ -88,6 +88,16 @@ impl Jitter {
     /// `profile`'s jitter on every link, seeded; `None` for [`JitterProfile::None`].
     pub fn profile(profile: JitterProfile, seed: u64) -> Option<Jitter> {
         profile.model().map(|model| Jitter { model, seed, only: None })
+    }
+
+    /// Whether `link` is given this jitter: the link it names; with none named, every link of the
+    /// devices. The twin's own thread ([`Link::Twin`]) only when named: the devices' links are
+    /// what a client meets, and the jitter study's cases on every link are theirs.
+    pub fn applies_to(&self, link: Link) -> bool {
+        match self.only {
+            Some(only) => only == link,
+            None => link != Link::Twin,
+        }
     }
 }
 
@@ -104,6 +114,10 @@ pub enum Link {
     Peaks = 3,
     /// The Dynamixel bus: a request, its processing and its replies.
     Bus = 4,
+    /// The twin's own thread (only when named): not run for the stall, its physics falls behind
+    /// real time and then catches up tick after tick, as on a busy PC or a virtual machine whose
+    /// host holds it.
+    Twin = 5,
 }
 
 /// When each packet handed to one link leaves it (see the module docs).
@@ -155,7 +169,7 @@ pub struct Held<T> {
 impl<T> Held<T> {
     /// The link `link` timed by `jitter` (`None`: nothing injected), its clock starting at `epoch`.
     pub fn new(jitter: Option<Jitter>, link: Link, epoch: Instant) -> Held<T> {
-        let jitter = jitter.filter(|j| j.only.is_none_or(|only| only == link));
+        let jitter = jitter.filter(|j| j.applies_to(link));
         let line = jitter.map(|j| DelayLine::new(j.model, j.seed, link));
         Held { line, epoch, queue: VecDeque::new() }
     }
@@ -236,6 +250,14 @@ mod tests {
         d.sort_by(f64::total_cmp);
         let median = d[d.len() / 2];
         assert!((median - 3e-3).abs() < 0.3e-3, "{median}");
+    }
+
+    #[test]
+    fn the_twin_stalls_only_when_named_and_a_named_link_alone_is_given_the_jitter() {
+        let every = Jitter::profile(JitterProfile::BusyPc, 1).unwrap();
+        assert!(every.applies_to(Link::RtdeIn) && every.applies_to(Link::Bus) && !every.applies_to(Link::Twin));
+        let twin = Jitter { only: Some(Link::Twin), ..every };
+        assert!(twin.applies_to(Link::Twin) && !twin.applies_to(Link::Peaks));
     }
 
     #[test]

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+pub mod arrival;
 mod bus;
 pub mod config;
 pub mod controller;

@@ -167,7 +167,13 @@ async fn serve_rtde(
 fn feed(session: &mut ServerSession, buf: &mut Vec<u8>, bytes: &[u8], state: &Shared) -> Option<Vec<u8>> {
     buf.extend_from_slice(bytes);
     let mut s = lock(state);
-    match session.feed(buf, &mut s.inputs) {
+    let before = s.inputs.packages;
+    let fed = session.feed(buf, &mut s.inputs);
+    if s.inputs.packages != before {
+        let s = &mut *s;
+        s.program_inputs.arrived(&s.inputs);
+    }
+    match fed {
         Ok(out) if buf.len() <= MAX_PENDING => Some(out),
         _ => None,
     }

@@ -73,13 +73,13 @@ struct Host<'a> {
 
 impl Controller for Host<'_> {
     fn input_int(&self, i: usize) -> i32 {
-        self.s.inputs.values.int_registers[i]
+        self.s.program_inputs.values.int_registers[i]
     }
     fn input_float(&self, i: usize) -> f64 {
-        self.s.inputs.values.double_registers[i]
+        self.s.program_inputs.values.double_registers[i]
     }
     fn input_bool(&self, i: usize) -> bool {
-        self.s.inputs.values.bit_registers >> i & 1 == 1
+        self.s.program_inputs.values.bit_registers >> i & 1 == 1
     }
     fn set_output_int(&mut self, i: usize, v: i32) {
         self.s.outputs.int_registers[i] = v;
@@ -102,7 +102,7 @@ impl Controller for Host<'_> {
         self.measured_q
     }
     fn input_packages(&self) -> u64 {
-        self.s.inputs.packages
+        self.s.program_inputs.packages
     }
     fn set_watchdog(&mut self, watchdog: RtdeWatchdog) {
         self.s.watchdog = Some(watchdog);
@@ -125,6 +125,8 @@ impl ProgramRunner {
     /// or ends the program and returns what the arm should do.
     pub fn tick(&mut self, s: &mut DeviceState, now_s: f64, measured_q: [f64; 6]) -> ArmCommand {
         let mut hold = false;
+        // The program reads the RTDE packages that had arrived by now (see `arrival`).
+        s.program_inputs.advance_to(now_s);
         // A new upload replaces the running program. The script port set it playing when it
         // arrived; a dashboard `pause`, `stop` or `power off` since then stands (setting it
         // playing here again, a tick late, restarted programs the dashboard had stopped).
@@ -263,12 +265,77 @@ mod tests {
     use crate::controller::VirtualUrSetup;
     use tendril_drivers::HardwareConfig;
     use tendril_fbg::SpectralConfig;
+    use tendril_rtde::RtdeValue;
 
     /// What `serve_script` does when a complete program arrives.
     fn upload(s: &mut DeviceState) {
         s.program_source = Some(FOLLOW_SCRIPT.to_string());
         s.program_uploads += 1;
         s.program = ProgramState::Playing;
+    }
+
+    /// The follow program's `servoj` targets, one per 2 ms cycle, fed a client's constant-speed
+    /// stream (a stamped target every 10 ms, 0.2 ms on the way) by a twin that stalls for `stall_s`
+    /// at twin time 1.003 s and then catches up at once: each cycle's step over the stream's.
+    fn servo_speed_ratios(stall_s: f64) -> Vec<(f64, f64)> {
+        let (state, _) = crate::state::shared_state(
+            &HardwareConfig::default(),
+            &SpectralConfig::default(),
+            &VirtualUrSetup::default(),
+        )
+        .unwrap();
+        let mut s = state.lock().unwrap();
+        upload(&mut s);
+        let home = [-1.57, -1.57, 1.57, -1.57, -1.57, 0.0];
+        let speed = 0.05;
+        let mut runner = ProgramRunner::default();
+        let (mut next_package, mut last) = (0u32, None::<([f64; 6], f64)>);
+        let mut ratios = Vec::new();
+        for k in 0..3000u32 {
+            let now_s = f64::from(k) * 1e-3;
+            // The wall clock at this tick: the stalled ticks all run when the stall ends.
+            let wall_s = if (1.003..1.003 + stall_s).contains(&now_s) { 1.003 + stall_s } else { now_s };
+            // The client's packages that arrived by then, each stamped with its read time.
+            while f64::from(next_package) * 0.01 + 0.0002 <= wall_s {
+                let stamp_s = f64::from(next_package) * 0.01;
+                let names = tendril_urscript::input_names();
+                let values = home.map(|h| RtdeValue::Double(h + speed * stamp_s)).into_iter();
+                let values = values.chain([RtdeValue::Double(stamp_s), RtdeValue::Int32(1)]);
+                let s = &mut *s;
+                s.inputs.apply_package(names.iter().map(String::as_str).zip(values));
+                s.program_inputs.arrived_at(stamp_s + 0.0002, &s.inputs);
+                next_package += 1;
+            }
+            let measured = last.map_or(home, |(q, _)| q);
+            if let ArmCommand::Servo { q, at_s } = runner.tick(&mut s, now_s, measured) {
+                if let Some((q0, t0)) = last
+                    && at_s > 0.2
+                {
+                    ratios.push((at_s, (q[0] - q0[0]) / (at_s - t0) / speed));
+                }
+                last = Some((q, at_s));
+            }
+        }
+        ratios
+    }
+
+    #[test]
+    fn a_twin_that_stalls_and_catches_up_plays_the_stream_at_its_own_speed() {
+        let steady = servo_speed_ratios(0.0);
+        assert!(steady.len() > 1000);
+        for stall_s in [0.0, 0.008, 0.02] {
+            for (at_s, r) in servo_speed_ratios(stall_s) {
+                // Packages held back to their arrival: the arm's setpoint never jumps. Made visible
+                // at once, a package that came during the stall reached the program up to a stall
+                // early on its clock; the program took it for the new earliest arrival and its
+                // playback jumped ahead in one cycle: 5 and 10 times the stream's speed for 8 and
+                // 20 ms stalls (measured with the packages made visible at once).
+                assert!(
+                    (r - 1.0).abs() < 0.01,
+                    "stall {stall_s} s: at {at_s:.3} s the setpoint moved {r:.3} times the stream's speed"
+                );
+            }
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! What the virtual devices share: the UR5e's RTDE inputs and outputs, its program and controller
 //! state, the MX-106 pair, the interrogator, and the twin's latest status.
 
+use super::arrival::ProgramInputs;
 use super::controller::{UrController, VirtualUrSetup};
 use std::sync::{Arc, Mutex};
 use tendril_cell::{ARM_JOINTS, GroundTruth};
@@ -59,8 +60,10 @@ pub enum ProgramState {
 pub struct DeviceState {
     /// What the virtual UR5e reports.
     pub outputs: RobotOutputs,
-    /// What RTDE clients wrote.
+    /// What RTDE clients wrote, as they arrive.
     pub inputs: SharedInputs,
+    /// What RTDE clients wrote, as the program sees it: from the twin time each package arrived at.
+    pub program_inputs: ProgramInputs,
     /// The program's state: it plays from its upload until it ends, fails, or its RTDE watchdog,
     /// a protective stop or the dashboard stops it ([`super::program`]).
     pub program: ProgramState,
@@ -116,6 +119,7 @@ pub fn shared_state(
     let state = DeviceState {
         outputs: RobotOutputs::default(),
         inputs: SharedInputs::new(),
+        program_inputs: ProgramInputs::default(),
         program: ProgramState::Stopped,
         program_source: None,
         watchdog: None,

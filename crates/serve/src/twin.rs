@@ -1,5 +1,6 @@
 //! The twin thread: the SimCell stepped in real time, its state put into the devices each tick.
 
+use super::jitter::{DelayLine, Jitter, Link};
 use super::program::{ArmCommand, ProgramRunner};
 use super::setpoint::{ArmPath, servo_delay_s};
 use super::state::{DeviceState, ProgramState, TwinStatus, lock};
@@ -59,7 +60,8 @@ fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64,
     (t, std::array::from_fn(|j| before.1[j] + (after.1[j] - before.1[j]) * f))
 }
 
-/// Runs the twin in real time on its own thread (the MuJoCo data stays on it).
+/// Runs the twin in real time on its own thread (the MuJoCo data stays on it); `jitter`, if it
+/// names [`Link::Twin`], stalls that thread.
 pub fn spawn(
     scenario: PickPlaceScenario,
     period_s: f64,
@@ -67,6 +69,7 @@ pub fn spawn(
     ticks: tokio::sync::watch::Sender<u64>,
     stop: Arc<AtomicBool>,
     realtime: RealtimeOptions,
+    jitter: Option<Jitter>,
 ) -> anyhow::Result<std::thread::JoinHandle<Result<(), String>>> {
     let model = SceneModel::build(&scenario.scene_spec())?;
     let motors = scenario.hardware.motor_ids();
@@ -122,6 +125,10 @@ pub fn spawn(
         // The devices now answer as the twin stands: `spawn` may return.
         let _ = ready.send(());
         let started = Instant::now();
+        lock(&state).program_inputs.start_clock(started);
+        // Injected stalls of this thread, on the twin's clock: a tick due in one waits for its end.
+        let mut stalls =
+            jitter.filter(|j| j.applies_to(Link::Twin)).map(|j| DelayLine::new(j.model, j.seed, Link::Twin));
         for k in 1u64.. {
             if stop.load(Ordering::SeqCst) {
                 return Ok(());
@@ -247,7 +254,9 @@ pub fn spawn(
                 };
             }
             ticks.send_replace(k);
-            let deadline = started + Duration::from_secs_f64(k as f64 * period_s);
+            let due_s = k as f64 * period_s;
+            let due_s = stalls.as_mut().map_or(due_s, |line| line.release_s(due_s));
+            let deadline = started + Duration::from_secs_f64(due_s);
             let now = Instant::now();
             if deadline > now {
                 std::thread::sleep(deadline - now);
