@@ -112,15 +112,16 @@ impl Point {
         }
     }
 
-    /// The project's default settings (`PhysicsConfig` and `FingerConfig` defaults: implicitfast,
-    /// elliptic cones, Newton).
+    /// A graded finger (`finger.base_refinement`, `finger.fine_from_m` \[m\]) with implicitfast,
+    /// elliptic cones and Newton.
+    fn graded(timestep_s: f64, segments: u32, base_refinement: u32, fine_from_m: f64) -> Point {
+        Point { base_refinement, fine_from_m, ..Point::mujoco(timestep_s, "implicitfast", "elliptic", segments) }
+    }
+
+    /// The project's default settings (`PhysicsConfig` and `FingerConfig` defaults).
     fn project_default() -> Point {
         let (p, f) = (PhysicsConfig::default(), FingerConfig::default());
-        Point {
-            base_refinement: f.base_refinement,
-            fine_from_m: f.fine_from_m,
-            ..Point::mujoco(p.timestep_s, "implicitfast", "elliptic", f.segments)
-        }
+        Point::graded(p.timestep_s, f.segments, f.base_refinement, f.fine_from_m)
     }
 
     fn rapier(timestep_s: f64, iterations: u32, segments: u32) -> Point {
@@ -175,13 +176,9 @@ pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::
                 labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
             }
         }
-        for &(segments, base_refinement, fine_from_m) in &grid.graded {
-            labels.push(Point {
-                base_refinement,
-                fine_from_m,
-                ..Point::mujoco(dt, "implicitfast", "elliptic", segments)
-            });
-        }
+        labels.extend(
+            grid.graded.iter().map(|&(segments, refinement, from_m)| Point::graded(dt, segments, refinement, from_m)),
+        );
     }
     let default = Point::project_default();
     let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), threads)?;

@@ -87,7 +87,12 @@ impl SharedInputs {
                 io.push((name.to_string(), value));
             }
             self.values.apply(name, value);
-            *self.writes.entry(name.to_string()).or_insert(0) += 1;
+            match self.writes.get_mut(name) {
+                Some(n) => *n += 1,
+                None => {
+                    self.writes.insert(name.to_string(), 1);
+                }
+            }
         }
         if !io.is_empty() {
             if self.io_packages.len() >= MAX_IO_PACKAGES {
