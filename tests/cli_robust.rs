@@ -249,7 +249,7 @@ fn serve_stops_cleanly_on_sigterm() {
             let l = std::net::TcpListener::bind("127.0.0.1:0").ok()?;
             let p = l.local_addr().ok()?.port();
             drop(l);
-            (p < 65000 && (1..6).all(|i| std::net::TcpListener::bind(("127.0.0.1", p + i)).is_ok())).then_some(p)
+            (p < 65000 && (1..7).all(|i| std::net::TcpListener::bind(("127.0.0.1", p + i)).is_ok())).then_some(p)
         })
         .expect("free ports");
     let out = signal_after(

@@ -312,6 +312,12 @@ impl tendril_urscript::Controller for NullController {
     fn actual_q(&self) -> [f64; 6] {
         [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]
     }
+    fn actual_qd(&self) -> [f64; 6] {
+        [0.0; 6]
+    }
+    fn actual_tcp_force(&self) -> [f64; 6] {
+        [0.0; 6]
+    }
     fn input_packages(&self) -> u64 {
         0
     }

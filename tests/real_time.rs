@@ -12,3 +12,4 @@ mod serve_run_e2e;
 mod virtual_dashboard;
 mod virtual_hyperion;
 mod virtual_ur;
+mod virtual_ur_driver;

@@ -54,19 +54,19 @@ impl Server {
     }
 }
 
-/// Six consecutive free ports on loopback (serve's `--port-base N` takes N..N+5), away from the
+/// Seven consecutive free ports on loopback (serve's `--port-base N` takes N..N+6), away from the
 /// fixed bases of the in-process tests (217xx-218xx) and the devices' own ports.
 fn free_port_base() -> u16 {
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
     let seed = u64::from(std::process::id()) ^ now.as_nanos() as u64;
     for attempt in 0..200u64 {
         let base = 41_000 + ((seed.wrapping_mul(2_654_435_761).wrapping_add(attempt * 97)) % 9_000) as u16 * 2;
-        let all_free = (base..base + 6).all(|p| TcpListener::bind(("127.0.0.1", p)).is_ok());
+        let all_free = (base..base + 7).all(|p| TcpListener::bind(("127.0.0.1", p)).is_ok());
         if all_free {
             return base;
         }
     }
-    panic!("no six consecutive free ports found");
+    panic!("no seven consecutive free ports found");
 }
 
 /// Starts `tendril serve SHORT_LIFT` on a free port base; a base taken in the meantime is retried.

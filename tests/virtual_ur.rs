@@ -366,21 +366,23 @@ fn bad_programs_stop_with_their_line_in_the_log_and_serve_runs_the_next_one() {
     let log_after = |serve: &ServeHandle, from: usize| -> Vec<String> {
         serve.state.lock().unwrap().program_log.iter().skip(from).cloned().collect()
     };
-    for (program, line, what) in [
+    for (program, line, what, within_ms) in [
         // An unsupported builtin after a statement that ran.
         (
             "def bad():\n  textmsg(\"started\")\n  sync()\n  force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,5,0,0,0], 2, [0.1,0.1,0.1,0.1,0.1,0.1])\nend\n",
             "line 4",
             "force_mode",
+            100,
         ),
-        // An endless loop without sync(): a runtime error, not a hung twin.
-        ("def spin():\n  x = 0\n  while True:\n    x = x + 1\n  end\nend\n", "line 4", "endless loop"),
+        // An endless loop without sync(): preempted each frame, then (after 1 s of it) a runtime
+        // error, never a hung twin.
+        ("def spin():\n  x = 0\n  while True:\n    x = x + 1\n  end\nend\n", "line 4", "endless loop", 1500),
         // A syntax error: the program does not start.
-        ("def broken():\n  x = (1 +\n  y = 2\nend\n", "line 3", "syntax error"),
+        ("def broken():\n  x = (1 +\n  y = 2\nend\n", "line 3", "syntax error", 100),
     ] {
         let seen = serve.state.lock().unwrap().program_log.len();
         upload(&serve, program);
-        let s = c.latest_after(Duration::from_millis(100));
+        let s = c.latest_after(Duration::from_millis(within_ms));
         assert_eq!(int(&s[2]), 1, "{program}: stopped");
         let log = log_after(&serve, seen);
         assert!(log.iter().any(|l| l.contains(line) && l.contains(what)), "{program}: {log:?}");

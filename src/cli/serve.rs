@@ -18,11 +18,15 @@ pub struct ServeArgs {
     /// Address to listen on; loopback unless asked otherwise.
     #[arg(long, default_value = "127.0.0.1")]
     bind: IpAddr,
-    /// Ports N (RTDE), N+1 (URScript), N+2 (HYPERION commands), N+3 (peaks), N+4 (UR dashboard),
-    /// N+5 (URScript, real-time port) instead of the devices' 30004, 30002, 51971, 51972, 29999,
-    /// 30003.
-    #[arg(long, value_parser = super::devices::port_base)]
+    /// Ports N (RTDE), N+1 (URScript, secondary), N+2 (HYPERION commands), N+3 (peaks), N+4 (UR
+    /// dashboard), N+5 (URScript, real-time), N+6 (UR primary interface) instead of the devices'
+    /// 30004, 30002, 51971, 51972, 29999, 30003, 30001.
+    #[arg(long, value_parser = port_base)]
     port_base: Option<u16>,
+    /// A host the UR5e's programs may open sockets to besides loopback (repeatable; an IP
+    /// address, as a program names it).
+    #[arg(long = "allow-host")]
+    allow_host: Vec<IpAddr>,
     /// Stop after this many seconds, up to a week (default: until Ctrl-C, SIGTERM or SIGHUP).
     #[arg(long, value_parser = super::seconds_arg)]
     seconds: Option<f64>,
@@ -48,6 +52,15 @@ pub struct ServeArgs {
     realtime: super::realtime::RealtimeArgs,
 }
 
+/// Parses `--port-base N`: seven ports N..N+6 must fit below 65536.
+fn port_base(text: &str) -> Result<u16, String> {
+    let base: u16 = text.parse().map_err(|e| format!("{e}"))?;
+    if base == 0 || base > u16::MAX - 6 {
+        return Err(format!("must be 1-{} (ports N..N+6)", u16::MAX - 6));
+    }
+    Ok(base)
+}
+
 pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     let overlay = tendril_config::Overlay::load(a.overlay.as_deref())?;
     let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.set)?;
@@ -57,13 +70,15 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     if let Some(base) = a.port_base {
         config = config.with_port_base(base);
     }
+    config.script_hosts = a.allow_host;
     config.jitter = Jitter::profile(a.jitter, a.jitter_seed).map(|j| Jitter { only: a.jitter_link, ..j });
     let handle = start(&scenario, &config)?;
     let [rtde, script, command, stream] = handle.addrs;
-    let (dashboard, realtime_script) = (handle.ur_addrs.dashboard, handle.ur_addrs.realtime_script);
+    let (dashboard, realtime_script, primary) =
+        (handle.ur_addrs.dashboard, handle.ur_addrs.realtime_script, handle.ur_addrs.primary);
     let h = handle.hardware;
     emit(&format!(
-        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {script}, {realtime_script}\n  Dashboard {dashboard}\n  HYPERION  {command} (commands), {stream} (peaks; FBG1, FBG2 on channel {})\n  Dynamixel {} (MX-106 IDs {} growth, {} twine; {} bit/s)\n",
+        "tendril serve: {}\n  RTDE      {rtde}\n  URScript  {primary} (primary), {script} (secondary), {realtime_script}\n  Dashboard {dashboard}\n  HYPERION  {command} (commands), {stream} (peaks; FBG1, FBG2 on channel {})\n  Dynamixel {} (MX-106 IDs {} growth, {} twine; {} bit/s)\n",
         scenario.name,
         h.fbg.channel,
         handle.pty_path.display(),

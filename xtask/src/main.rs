@@ -14,9 +14,13 @@
 //!   first (the pinned version, from crates.io) into `vendor/mdbook`.
 //! - `cargo xtask publish-check`: `cargo publish --dry-run` of the crates made to be used on their
 //!   own ([`layers::published`]): each is packaged and built from its package alone.
+//! - `cargo xtask urcl PATH-TO-LIBRARY`: Universal Robots' client library's examples against
+//!   `tendril serve` ([`urcl`]).
 
 mod layers;
 mod modules;
+mod rtde_trace;
+mod urcl;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -36,8 +40,9 @@ fn main() -> ExitCode {
         "layers" => check_layers(),
         "book" => build_book(rest),
         "publish-check" => publish_check(rest),
+        "urcl" => fetch_mujoco().and_then(|_| urcl_check(rest)),
         _ => {
-            eprintln!("usage: cargo xtask <fetch|main|test|layers|book|publish-check> [extra cargo args]");
+            eprintln!("usage: cargo xtask <fetch|main|test|layers|book|publish-check|urcl> [extra cargo args]");
             return ExitCode::from(2);
         }
     };
@@ -209,6 +214,14 @@ fn python_clients() -> Result<PathBuf, String> {
     run(Command::new(&python).args(["-m", "pip", "install", "--quiet", "--only-binary=:all:"]).args(PYTHON_CLIENTS))?;
     std::fs::write(&stamp, "").map_err(|e| format!("{}: {e}", stamp.display()))?;
     Ok(python)
+}
+
+/// `cargo xtask urcl`: builds `tendril` (release) and runs UR's client library's examples against it.
+fn urcl_check(rest: &[String]) -> Result<(), String> {
+    let root = workspace_root();
+    run(cargo().args(["build", "--release", "--quiet", "--bin", "tendril"]))?;
+    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
+    urcl::run(&root, &target.join("release/tendril"), rest)
 }
 
 /// `cargo xtask layers`: every broken rule printed; fails if there is one.

@@ -42,6 +42,10 @@ pub enum Command {
     PolyscopeVersion,
     /// `close safety popup`.
     CloseSafetyPopup,
+    /// `close popup`.
+    ClosePopup,
+    /// `saveLog`: flush the log to disk.
+    SaveLog,
     /// `unlock protective stop`.
     UnlockProtectiveStop,
     /// `get serial number` (PolyScope 5.6 and later; SDU ur_rtde's control interface asks).
@@ -75,6 +79,8 @@ impl Command {
             "safetymode" => Command::SafetyMode,
             "polyscopeversion" => Command::PolyscopeVersion,
             "close safety popup" => Command::CloseSafetyPopup,
+            "close popup" => Command::ClosePopup,
+            "savelog" => Command::SaveLog,
             "get serial number" => Command::GetSerialNumber,
             "get robot model" => Command::GetRobotModel,
             "unlock protective stop" => Command::UnlockProtectiveStop,
@@ -102,6 +108,8 @@ impl Command {
             Command::SafetyMode => "safetymode",
             Command::PolyscopeVersion => "PolyscopeVersion",
             Command::CloseSafetyPopup => "close safety popup",
+            Command::ClosePopup => "close popup",
+            Command::SaveLog => "saveLog",
             Command::UnlockProtectiveStop => "unlock protective stop",
             Command::GetSerialNumber => "get serial number",
             Command::GetRobotModel => "get robot model",
@@ -286,6 +294,10 @@ pub mod reply {
     pub const PAUSE_FAILED: &str = "Failed to execute: pause";
     /// `close safety popup`.
     pub const CLOSING_SAFETY_POPUP: &str = "closing safety popup";
+    /// `close popup`.
+    pub const CLOSING_POPUP: &str = "closing popup";
+    /// `saveLog`.
+    pub const LOG_SAVED: &str = "Log saved to disk";
     /// `unlock protective stop`, success.
     pub const PROTECTIVE_STOP_RELEASING: &str = "Protective stop releasing";
     /// `unlock protective stop` within 5 s of the stop.

@@ -98,6 +98,29 @@ pub const FIXED_OUTPUTS: &[(&str, RtdeType)] = &[
     ("actual_configurable_digital_output_bits", Uint64),
     ("encoder0_raw", Int32),
     ("encoder1_raw", Int32),
+    // Newer controllers' outputs, as UR's client library lists them in its exhaustive recipe
+    // (types from its `DataPackage` table): the TCP accelerations, differenced from the twin's
+    // TCP speeds; the gravity vector the program set (`set_gravity`, URScript's default
+    // [0, 0, 9.82] m/s² until then).
+    ("actual_TCP_acceleration", Vector6d),
+    ("target_TCP_acceleration", Vector6d),
+    ("target_gravity", Vector3d),
+];
+
+/// Outputs of newer PolyScope 5 controllers the virtual UR5e answers with `NOT_FOUND`, as a
+/// controller answers a name it does not serve, and why: a client that asks for them either
+/// drops them (UR's client library with `ignore_unavailable_outputs`) or learns at setup that the
+/// twin does not have them, instead of reading a made-up value.
+pub const NOT_SERVED: &[(&str, &str)] = &[
+    ("actual_current_as_torque", "the twin models no motor currents"),
+    ("wrench_calc_from_currents", "the twin models no motor currents"),
+    ("actual_robot_energy_consumed", "the twin models no electrical power"),
+    ("actual_robot_braking_energy_dissipated", "the twin models no electrical power"),
+    ("target_base_acceleration", "not defined in the RTDE documentation we work from"),
+    ("target_base_wrench", "not defined in the RTDE documentation we work from"),
+    ("target_execution_time", "not defined in the RTDE documentation we work from"),
+    ("control_step", "not defined in the RTDE documentation we work from"),
+    ("time_scale_source", "not defined in the RTDE documentation we work from"),
 ];
 
 /// Input fields with a fixed name.
@@ -131,6 +154,14 @@ pub const TWIN_OUTPUTS: &[&str] = &[
     "actual_TCP_speed",
     "actual_TCP_force",
     "target_TCP_pose",
+    "target_TCP_speed",
+    "actual_TCP_acceleration",
+    "target_TCP_acceleration",
+    "target_gravity",
+    "payload",
+    "payload_cog",
+    "payload_inertia",
+    "tool_output_voltage",
     "tcp_offset",
     "robot_mode",
     "safety_mode",
@@ -308,6 +339,16 @@ mod tests {
         assert_eq!(output_type("actual_configurable_digital_output_bits"), Some(Uint64));
         assert_eq!(output_type("encoder0_raw"), Some(Int32));
         assert_eq!(output_type("encoder1_raw"), Some(Int32));
+    }
+
+    #[test]
+    fn newer_controllers_outputs_are_served_or_not_found() {
+        assert_eq!(output_type("actual_TCP_acceleration"), Some(Vector6d));
+        assert_eq!(output_type("target_TCP_acceleration"), Some(Vector6d));
+        assert_eq!(output_type("target_gravity"), Some(Vector3d));
+        for (name, why) in NOT_SERVED {
+            assert_eq!(output_type(name), None, "{name} is answered NOT_FOUND: {why}");
+        }
     }
 
     #[test]

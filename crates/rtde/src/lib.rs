@@ -6,6 +6,7 @@ pub mod dashboard;
 mod error;
 pub mod fields;
 pub mod packet;
+pub mod primary;
 pub mod recipe;
 pub mod server;
 pub mod state;

@@ -17,6 +17,8 @@ pub const RUNTIME_STATE_PLAYING: u32 = 2;
 pub const RUNTIME_STATE_STOPPED: u32 = 1;
 /// `runtime_state` value of a paused program (PAUSED).
 pub const RUNTIME_STATE_PAUSED: u32 = 4;
+/// URScript's default gravity vector (`set_gravity`'s \[0, 0, 9.82\] m/s², base frame).
+pub const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, 9.82];
 /// `joint_mode` value of a running joint (JOINT_RUNNING_MODE).
 pub const JOINT_MODE_RUNNING: i32 = 253;
 
@@ -42,6 +44,23 @@ pub struct RobotOutputs {
     pub actual_tcp_force: [f64; 6],
     /// Commanded TCP pose.
     pub target_tcp_pose: [f64; 6],
+    /// Commanded TCP twist (m/s, rad/s).
+    pub target_tcp_speed: [f64; 6],
+    /// TCP acceleration (m/s², rad/s²).
+    pub actual_tcp_acceleration: [f64; 6],
+    /// Commanded TCP acceleration (m/s², rad/s²).
+    pub target_tcp_acceleration: [f64; 6],
+    /// The gravity vector the program set with `set_gravity` \[m/s²\] (base frame; URScript's
+    /// default \[0, 0, 9.82\]).
+    pub gravity: [f64; 3],
+    /// The payload the program set with `set_payload` \[kg\].
+    pub payload_kg: f64,
+    /// Its centre of gravity from the flange \[m\].
+    pub payload_cog: [f64; 3],
+    /// Its inertia matrix \[Ixx, Iyy, Izz, Ixy, Ixz, Iyz\] \[kg·m²\] (`set_target_payload`).
+    pub payload_inertia: [f64; 6],
+    /// The tool output voltage the program set with `set_tool_voltage` \[V\] (0, 12 or 24).
+    pub tool_output_voltage: i32,
     /// The TCP's offset from the tool flange (m, rotation vector in rad; zeros: the flange).
     pub tcp_offset: [f64; 6],
     /// Robot mode (7 running).
@@ -80,6 +99,14 @@ impl Default for RobotOutputs {
             actual_tcp_speed: [0.0; 6],
             actual_tcp_force: [0.0; 6],
             target_tcp_pose: [0.0; 6],
+            target_tcp_speed: [0.0; 6],
+            actual_tcp_acceleration: [0.0; 6],
+            target_tcp_acceleration: [0.0; 6],
+            gravity: DEFAULT_GRAVITY,
+            payload_kg: 0.0,
+            payload_cog: [0.0; 3],
+            payload_inertia: [0.0; 6],
+            tool_output_voltage: 0,
             tcp_offset: [0.0; 6],
             robot_mode: ROBOT_MODE_RUNNING,
             safety_mode: SAFETY_MODE_NORMAL,
@@ -168,6 +195,14 @@ pub(crate) enum OutputSource {
     ActualTcpSpeed,
     ActualTcpForce,
     TargetTcpPose,
+    TargetTcpSpeed,
+    ActualTcpAcceleration,
+    TargetTcpAcceleration,
+    Gravity,
+    Payload,
+    PayloadCog,
+    PayloadInertia,
+    ToolOutputVoltage,
     TcpOffset,
     RobotMode,
     SafetyMode,
@@ -207,6 +242,14 @@ impl OutputSource {
             "actual_TCP_speed" => ActualTcpSpeed,
             "actual_TCP_force" => ActualTcpForce,
             "target_TCP_pose" => TargetTcpPose,
+            "target_TCP_speed" => TargetTcpSpeed,
+            "actual_TCP_acceleration" => ActualTcpAcceleration,
+            "target_TCP_acceleration" => TargetTcpAcceleration,
+            "target_gravity" => Gravity,
+            "payload" => Payload,
+            "payload_cog" => PayloadCog,
+            "payload_inertia" => PayloadInertia,
+            "tool_output_voltage" => ToolOutputVoltage,
             "tcp_offset" => TcpOffset,
             "robot_mode" => RobotMode,
             "safety_mode" => SafetyMode,
@@ -245,6 +288,14 @@ impl OutputSource {
             ActualTcpSpeed => V::Vector6d(out.actual_tcp_speed),
             ActualTcpForce => V::Vector6d(out.actual_tcp_force),
             TargetTcpPose => V::Vector6d(out.target_tcp_pose),
+            TargetTcpSpeed => V::Vector6d(out.target_tcp_speed),
+            ActualTcpAcceleration => V::Vector6d(out.actual_tcp_acceleration),
+            TargetTcpAcceleration => V::Vector6d(out.target_tcp_acceleration),
+            Gravity => V::Vector3d(out.gravity),
+            Payload => V::Double(out.payload_kg),
+            PayloadCog => V::Vector3d(out.payload_cog),
+            PayloadInertia => V::Vector6d(out.payload_inertia),
+            ToolOutputVoltage => V::Int32(out.tool_output_voltage),
             TcpOffset => V::Vector6d(out.tcp_offset),
             RobotMode => V::Int32(out.robot_mode),
             SafetyMode => V::Int32(out.safety_mode),

@@ -190,3 +190,41 @@ fn bad_input_package_gets_an_error_message_not_a_panic() {
     assert!(matches!(&r[0], ServerPacket::Text(t) if t.level == MessageLevel::Error));
     assert!(output_type("actual_q").is_some());
 }
+
+#[test]
+fn newer_controllers_outputs_are_typed_valued_or_not_found() {
+    let mut server = ServerSession::new(1, ServerConfig::default());
+    let mut shared = SharedInputs::new();
+    server.handle(ClientPacket::RequestProtocolVersion { version: 2 }, &mut shared);
+    let served =
+        ["actual_TCP_acceleration", "target_TCP_acceleration", "target_gravity", "target_TCP_speed", "payload"];
+    let names: Vec<String> = served.iter().map(|s| s.to_string()).collect();
+    let reply = server.handle(ClientPacket::SetupOutputs { frequency_hz: 125.0, names }, &mut shared);
+    let ServerPacket::SetupOutputs { recipe_id: 1, types } = &reply[0] else { panic!("{reply:?}") };
+    use RtdeType::*;
+    let known = [Vector6d, Vector6d, Vector3d, Vector6d, Double].map(FieldType::Known);
+    assert_eq!(types, &known);
+    server.handle(ClientPacket::Start, &mut shared);
+    let outputs = RobotOutputs {
+        actual_tcp_acceleration: [0.5, 0.0, 0.0, 0.0, 0.0, 0.1],
+        target_tcp_speed: [0.0, 0.0, -0.02, 0.0, 0.0, 0.0],
+        payload_kg: 2.0,
+        ..RobotOutputs::default()
+    };
+    let data = server.poll_outputs(0.0, &outputs, &shared);
+    let ServerPacket::Data { data, .. } = &data[0] else { panic!("no data package") };
+    let recipe = server.output_recipes().next().unwrap().0.clone();
+    let values = recipe.decode(data).unwrap();
+    assert_eq!(values[0], RtdeValue::Vector6d(outputs.actual_tcp_acceleration));
+    assert_eq!(values[2], RtdeValue::Vector3d([0.0, 0.0, 9.82]), "URScript's default gravity");
+    assert_eq!(values[3], RtdeValue::Vector6d(outputs.target_tcp_speed));
+    assert_eq!(values[4], RtdeValue::Double(2.0));
+
+    // The names the twin cannot give are answered as a controller answers a name it lacks.
+    let mut server = ServerSession::new(2, ServerConfig::default());
+    server.handle(ClientPacket::RequestProtocolVersion { version: 2 }, &mut shared);
+    let names: Vec<String> = super::fields::NOT_SERVED.iter().map(|(n, _)| n.to_string()).collect();
+    let reply = server.handle(ClientPacket::SetupOutputs { frequency_hz: 125.0, names }, &mut shared);
+    let ServerPacket::SetupOutputs { recipe_id: 0, types } = &reply[0] else { panic!("{reply:?}") };
+    assert!(types.iter().all(|t| *t == FieldType::NotFound), "{types:?}");
+}

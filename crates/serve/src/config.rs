@@ -16,6 +16,11 @@ pub struct ServeConfig {
     pub rtde_port: u16,
     /// URScript secondary interface port (30002).
     pub script_port: u16,
+    /// Primary interface port (30001): robot state and messages, and URScript.
+    pub primary_port: u16,
+    /// Hosts a program's `socket_open` may reach besides loopback (none by default; see
+    /// [`crate::sockets`]).
+    pub script_hosts: Vec<IpAddr>,
     /// URScript real-time interface port (30003): takes programs as the secondary one does.
     pub realtime_script_port: u16,
     /// UR Dashboard Server port (29999).
@@ -55,6 +60,8 @@ impl ServeConfig {
             bind: IpAddr::V4(Ipv4Addr::LOCALHOST),
             rtde_port: 30004,
             script_port: 30002,
+            primary_port: 30001,
+            script_hosts: Vec::new(),
             realtime_script_port: 30003,
             dashboard_port: 29999,
             ur: VirtualUrSetup::default(),
@@ -73,6 +80,7 @@ impl ServeConfig {
         ServeConfig {
             rtde_port: 0,
             script_port: 0,
+            primary_port: 0,
             realtime_script_port: 0,
             dashboard_port: 0,
             command_port: 0,
@@ -81,9 +89,9 @@ impl ServeConfig {
         }
     }
 
-    /// Ports `base`, `base+1`, `base+2`, `base+3`, `base+4`, `base+5` for RTDE, URScript
-    /// (secondary), HYPERION commands and stream, the dashboard server and URScript (real-time)
-    /// (tests and benchmarks use distinct bases so they never collide).
+    /// Ports `base`, `base+1`, `base+2`, `base+3`, `base+4`, `base+5`, `base+6` for RTDE, URScript
+    /// (secondary), HYPERION commands and stream, the dashboard server, URScript (real-time) and
+    /// the primary interface (tests and benchmarks use distinct bases so they never collide).
     pub fn with_port_base(mut self, base: u16) -> ServeConfig {
         self.rtde_port = base;
         self.script_port = base + 1;
@@ -91,6 +99,9 @@ impl ServeConfig {
         self.stream_port = base + 3;
         self.dashboard_port = base + 4;
         self.realtime_script_port = base + 5;
+        // Saturating: a base past 65529 leaves the primary port on the real-time one's, which
+        // then fails to bind with a clear error (`tendril serve --port-base` refuses such bases).
+        self.primary_port = base.saturating_add(6);
         self
     }
 }
@@ -102,4 +113,6 @@ pub struct UrAddrs {
     pub dashboard: SocketAddr,
     /// Real-time interface script port (30003).
     pub realtime_script: SocketAddr,
+    /// Primary interface (30001).
+    pub primary: SocketAddr,
 }

@@ -5,7 +5,8 @@
 //! it in a given state at start (tests use it to make each precondition of the real path fail);
 //! the dashboard commands change it as PolyScope would:
 //!
-//! - `power on` → IDLE, `brake release` → RUNNING, `power off` → POWER_OFF (the program stops);
+//! - `power on` → IDLE, `brake release` → RUNNING (powering on first when off), `power off` →
+//!   POWER_OFF (the program stops);
 //! - `play` starts the loaded or uploaded program if the robot is RUNNING, not protective-stopped
 //!   and in remote control; `stop`, `pause` as on the pendant;
 //! - `load NAME.urp` loads the one program the virtual controller has (it follows the RTDE
@@ -52,10 +53,10 @@ pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bo
             s.program = ProgramState::Stopped;
             reply::POWERING_OFF.into()
         }
+        // From power off too: the arm powers on first (UR's client library releases the brakes
+        // of a robot its dashboard example left powered off, and its examples then run).
         Command::BrakeRelease => {
-            if s.ur.robot_mode != RobotMode::PowerOff {
-                s.ur.robot_mode = RobotMode::Running;
-            }
+            s.ur.robot_mode = RobotMode::Running;
             reply::BRAKE_RELEASING.into()
         }
         Command::Play => {
@@ -89,6 +90,10 @@ pub fn answer(command: &Command, s: &mut DeviceState, now_s: f64) -> (String, bo
         Command::SafetyMode => format!("Safetymode: {}", safety(s).name()),
         Command::PolyscopeVersion => s.ur.polyscope_version.clone(),
         Command::CloseSafetyPopup => reply::CLOSING_SAFETY_POPUP.into(),
+        // The virtual controller shows no popups (a program's go to its log) and keeps its log in
+        // memory (`DeviceState::program_log`): nothing to close or to save.
+        Command::ClosePopup => reply::CLOSING_POPUP.into(),
+        Command::SaveLog => reply::LOG_SAVED.into(),
         Command::UnlockProtectiveStop => match s.ur.protective_stop_at {
             Some(at) if s.protective_stop.is_some() && now_s - at < UNLOCK_DELAY_S => {
                 reply::PROTECTIVE_STOP_TOO_SOON.into()

@@ -10,8 +10,12 @@ mod handle;
 pub mod io;
 pub mod jitter;
 mod net;
+pub mod primary;
 pub mod program;
+pub mod robot_messages;
+pub mod robot_state;
 mod setpoint;
+pub mod sockets;
 pub mod state;
 mod twin;
 

@@ -1,24 +1,20 @@
-//! The TCP side of the virtual devices: RTDE, URScript upload, HYPERION commands and stream.
+//! The TCP side of the virtual devices: RTDE, the script ports ([`super::primary`]), the dashboard,
+//! HYPERION commands and stream.
 
 use super::config::{ServeConfig, UrAddrs};
 use super::dashboard::answer;
 use super::jitter::{Held, Link};
-use super::state::{DeviceState, ProgramState, lock};
+use super::primary::{self, ScriptPort};
+use super::state::{DeviceState, lock};
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use tendril_rtde::dashboard::{Command, GREETING, RobotMode};
+use tendril_rtde::dashboard::{Command, GREETING};
 use tendril_rtde::{ServerConfig, ServerSession};
-use tendril_urscript::is_complete_program;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::watch;
 
-/// Largest URScript program accepted [bytes].
-const MAX_PROGRAM_LEN: usize = 1 << 20;
-/// How long a script connection must stay quiet after a complete-looking program before the
-/// program is taken.
-const PROGRAM_SETTLE: Duration = Duration::from_millis(50);
 /// A client sending more than this without completing a frame is dropped [bytes].
 const MAX_PENDING: usize = 1 << 20;
 
@@ -42,8 +38,15 @@ pub async fn listen_all(
     let stream = bind(c.stream_port).await?;
     let dashboard = bind(c.dashboard_port).await?;
     let realtime_script = bind(c.realtime_script_port).await?;
+    let primary = bind(c.primary_port).await?;
     let addrs = [rtde.local_addr()?, script.local_addr()?, command.local_addr()?, stream.local_addr()?];
-    let ur_addrs = UrAddrs { dashboard: dashboard.local_addr()?, realtime_script: realtime_script.local_addr()? };
+    let ur_addrs = UrAddrs {
+        dashboard: dashboard.local_addr()?,
+        realtime_script: realtime_script.local_addr()?,
+        primary: primary.local_addr()?,
+    };
+    // The program's sockets run on this runtime.
+    lock(&state).sockets.attach(tokio::runtime::Handle::current(), c.script_hosts.clone());
     let (idle, jitter) = (c.idle_timeout, c.jitter);
     {
         let (state, ticks) = (state.clone(), ticks.clone());
@@ -52,9 +55,11 @@ pub async fn listen_all(
             serve_rtde(s, state.clone(), ticks.clone(), idle, links)
         }));
     }
-    for listener in [script, realtime_script] {
-        let state = state.clone();
-        tokio::spawn(accept(listener, move |s| serve_script(s, state.clone())));
+    for (listener, port) in
+        [(primary, ScriptPort::Primary), (script, ScriptPort::Secondary), (realtime_script, ScriptPort::RealTime)]
+    {
+        let (state, ticks) = (state.clone(), ticks.clone());
+        tokio::spawn(accept(listener, move |s| primary::serve(s, port, state.clone(), ticks.clone())));
     }
     {
         let state = state.clone();
@@ -185,42 +190,6 @@ async fn sleep_until(at: Option<Instant>) {
         Some(at) => tokio::time::sleep_until(tokio::time::Instant::from_std(at)).await,
         None => std::future::pending().await,
     }
-}
-
-/// The secondary interface: a complete `def ... end` program replaces the running one and plays.
-async fn serve_script(mut socket: TcpStream, state: Shared) {
-    let mut text = Vec::new();
-    let mut chunk = [0u8; 4096];
-    loop {
-        // A text that ends in `end` may still be a part: a large program (SDU ur_rtde's is 40 kB)
-        // arrives in pieces, any of which can end with a nested block's `end`. So the program is
-        // taken once the client has sent nothing more for a moment (or closed the connection).
-        let complete = std::str::from_utf8(&text).is_ok_and(is_complete_program);
-        let wait = if complete { PROGRAM_SETTLE } else { Duration::from_secs(2) };
-        match tokio::time::timeout(wait, socket.read(&mut chunk)).await {
-            Ok(Ok(n)) if n > 0 && text.len() + n <= MAX_PROGRAM_LEN => text.extend_from_slice(&chunk[..n]),
-            _ => break,
-        }
-    }
-    let Ok(program) = std::str::from_utf8(&text) else { return };
-    if !is_complete_program(program) {
-        return;
-    }
-    let mut s = lock(&state);
-    // In local control (PolyScope 5.6 and later) the script ports take no programs; with the
-    // robot powered off or its brakes engaged a program cannot start.
-    if !s.ur.accepts_programs() || s.ur.robot_mode != RobotMode::Running {
-        return;
-    }
-    // The twin's program runner parses and starts it (a syntax error is logged, the program
-    // does not start, and the one before it has been replaced).
-    s.program_source = Some(program.to_string());
-    s.program_uploads += 1;
-    s.program = ProgramState::Playing;
-    // A fresh upload also clears a protective stop (see `safety`; a real controller wants
-    // `unlock protective stop` on the dashboard, which the virtual one takes as well).
-    s.protective_stop = None;
-    s.ur.protective_stop_at = None;
 }
 
 /// Longest dashboard command line accepted [bytes].

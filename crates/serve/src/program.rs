@@ -13,12 +13,26 @@
 //! The interpreter runs one 2 ms controller cycle whenever the twin's clock has reached the next
 //! cycle (the twin ticks every 1 ms by default), in twin time, so a twin held up by a busy
 //! machine never makes a program see time pass that the arm did not.
+//!
+//! A secondary program (`sec`, from the script ports) runs at the next tick, beside whatever
+//! plays, to its end in that tick (it may not consume time). The controller settings a program
+//! makes (`set_tcp`, `set_payload`, ...) are the controller's ([`DeviceState::program_setup`]):
+//! a main program starts from the defaults, a secondary one changes what the main one has. The
+//! primary interface hears of each program's start and end (key messages), of a runtime or
+//! syntax error (a runtime exception with its line), and of `textmsg` lines
+//! ([`crate::robot_messages`]). When a program ends, its sockets are closed.
 
+use super::robot_messages::{PROGRAM_STARTED, PROGRAM_STOPPED};
 use super::state::{DeviceState, ProgramState};
 use std::collections::VecDeque;
 use tendril_rtde::dashboard::RobotMode;
+use tendril_rtde::primary::RobotMessage;
+use tendril_rtde::primary::message::source;
 use tendril_urscript::interp::CONTROL_PERIOD_S;
-use tendril_urscript::{Controller, DigitalOut, FOLLOW_SCRIPT, Interpreter, RtdeWatchdog, Status, WatchdogAction};
+use tendril_urscript::{
+    Controller, DigitalOut, FOLLOW_SCRIPT, Interpreter, RtdeWatchdog, ScriptError, Setup, SocketState, Status,
+    WatchdogAction,
+};
 
 /// Lines kept in [`DeviceState::program_log`].
 pub const LOG_LINES: usize = 500;
@@ -69,6 +83,8 @@ struct Host<'a> {
     s: &'a mut DeviceState,
     measured_q: [f64; 6],
     watchdog_set: bool,
+    /// The program's cycle \[s\] (socket bytes are readable from the twin time they arrived).
+    now_s: f64,
 }
 
 impl Controller for Host<'_> {
@@ -101,6 +117,12 @@ impl Controller for Host<'_> {
     fn actual_q(&self) -> [f64; 6] {
         self.measured_q
     }
+    fn actual_qd(&self) -> [f64; 6] {
+        self.s.outputs.actual_qd
+    }
+    fn actual_tcp_force(&self) -> [f64; 6] {
+        self.s.tcp_force_raw
+    }
     fn input_packages(&self) -> u64 {
         self.s.program_inputs.packages
     }
@@ -110,7 +132,43 @@ impl Controller for Host<'_> {
     }
     fn message(&mut self, text: &str) {
         log(&mut self.s.program_log, text);
+        self.s.robot_messages.push(self.now_s, source::RT_MACHINE, RobotMessage::Text(text.to_string()));
     }
+    fn socket_open(&mut self, name: &str, host: &str, port: u16) -> Result<(), String> {
+        self.s.sockets.open(name, host, port, self.now_s)
+    }
+    fn socket_state(&self, name: &str) -> SocketState {
+        self.s.sockets.state(name)
+    }
+    fn socket_read(&mut self, name: &str, n: usize) -> Option<Vec<u8>> {
+        self.s.sockets.read(name, n, self.now_s)
+    }
+    fn socket_send(&mut self, name: &str, bytes: &[u8]) -> bool {
+        self.s.sockets.send(name, bytes)
+    }
+    fn socket_close(&mut self, name: &str) {
+        self.s.sockets.close(name);
+    }
+}
+
+/// Reports the controller settings a program made: RTDE's `tcp_offset`, `payload*`,
+/// `target_gravity`, `tool_output_voltage`, and (through [`DeviceState::program_setup`]) the
+/// force sensor's zero and freedrive.
+fn publish(s: &mut DeviceState, setup: &Setup) {
+    let o = &mut s.outputs;
+    o.tcp_offset = setup.tcp;
+    o.payload_kg = setup.payload_kg;
+    o.payload_cog = setup.payload_cog;
+    o.payload_inertia = setup.payload_inertia;
+    o.gravity = setup.gravity;
+    o.tool_output_voltage = setup.tool_voltage;
+    s.program_setup = setup.clone();
+}
+
+/// A program's error for the primary interface: a runtime exception at its line.
+fn runtime_exception(s: &mut DeviceState, now_s: f64, e: &ScriptError) {
+    let body = RobotMessage::RuntimeException { line: e.line as i32, column: 0, text: e.message.clone() };
+    s.robot_messages.push(now_s, source::RT_MACHINE, body);
 }
 
 fn log(lines: &mut VecDeque<String>, text: &str) {
@@ -124,6 +182,7 @@ impl ProgramRunner {
     /// One twin tick at `now_s` \[s\] with the arm measured at `measured_q`: starts, steps, pauses
     /// or ends the program and returns what the arm should do.
     pub fn tick(&mut self, s: &mut DeviceState, now_s: f64, measured_q: [f64; 6]) -> ArmCommand {
+        self.run_secondary(s, now_s, measured_q);
         let mut hold = false;
         // The program reads the RTDE packages that had arrived by now (see `arrival`).
         s.program_inputs.advance_to(now_s);
@@ -157,11 +216,15 @@ impl ProgramRunner {
         // A twin that fell behind by more than a cycle resumes the schedule from now.
         self.next_cycle_s = if cycle_s + CONTROL_PERIOD_S < now_s { now_s } else { cycle_s } + CONTROL_PERIOD_S;
         let Some(interpreter) = self.interpreter.as_mut() else { return ArmCommand::Keep };
-        let mut host = Host { s, measured_q, watchdog_set: false };
+        let mut host = Host { s, measured_q, watchdog_set: false, now_s: cycle_s };
         let command = interpreter.step(cycle_s, &mut host);
         let (servoing, qd) = (interpreter.servoing(), interpreter.target_qd());
         let watchdog_set = host.watchdog_set;
         let status = interpreter.status().clone();
+        if interpreter.setup() != &s.program_setup {
+            let setup = interpreter.setup().clone();
+            publish(s, &setup);
+        }
         if watchdog_set {
             self.arm_watchdog(s, now_s);
         }
@@ -175,6 +238,7 @@ impl ProgramRunner {
             }
             Status::Failed(e) => {
                 eprintln!("virtual UR5e: program stopped: {e}");
+                runtime_exception(s, cycle_s, &e);
                 s.program = ProgramState::Stopped;
                 self.end(s);
                 return ArmCommand::Hold;
@@ -200,6 +264,8 @@ impl ProgramRunner {
         let source = s.program_source.clone().unwrap_or_else(|| FOLLOW_SCRIPT.to_string());
         match Interpreter::new(&source, measured_q) {
             Ok(i) => {
+                s.robot_messages.key(now_s, PROGRAM_STARTED, i.name());
+                publish(s, &Setup::default());
                 self.interpreter = Some(i);
                 self.next_cycle_s = now_s;
             }
@@ -207,21 +273,52 @@ impl ProgramRunner {
                 let line = format!("syntax error, program not started: {e}");
                 eprintln!("virtual UR5e: {line}");
                 log(&mut s.program_log, &line);
+                runtime_exception(s, now_s, &e);
                 s.program = ProgramState::Stopped;
             }
         }
     }
 
-    /// Drops the interpreter and what it set: watchdog, output registers.
+    /// Drops the interpreter and what it set: watchdog, output registers, sockets.
     fn end(&mut self, s: &mut DeviceState) {
-        if self.interpreter.take().is_some() {
+        if let Some(i) = self.interpreter.take() {
             let o = &mut s.outputs;
             o.int_registers.fill(0);
             o.double_registers.fill(0.0);
             o.bit_registers = 0;
+            s.sockets.close_all();
+            let now = s.status.time_s;
+            s.robot_messages.key(now, PROGRAM_STOPPED, i.name());
         }
         self.armed = None;
         s.watchdog = None;
+    }
+
+    /// Runs the secondary programs that arrived, each to its end, with the controller's settings.
+    fn run_secondary(&mut self, s: &mut DeviceState, now_s: f64, measured_q: [f64; 6]) {
+        while let Some(text) = s.secondary_programs.pop_front() {
+            let mut program = match Interpreter::new(&text, measured_q) {
+                Ok(p) => p,
+                Err(e) => {
+                    log(&mut s.program_log, &format!("secondary program not started: {e}"));
+                    runtime_exception(s, now_s, &e);
+                    continue;
+                }
+            };
+            program.set_setup(s.program_setup.clone());
+            let mut host = Host { s, measured_q, watchdog_set: false, now_s };
+            program.step(now_s, &mut host);
+            if let Status::Failed(e) = program.status() {
+                runtime_exception(s, now_s, e);
+            }
+            let setup = program.setup().clone();
+            if setup != s.program_setup {
+                publish(s, &setup);
+                if let Some(main) = self.interpreter.as_mut() {
+                    main.set_setup(setup);
+                }
+            }
+        }
     }
 
     fn arm_watchdog(&mut self, s: &DeviceState, now_s: f64) {

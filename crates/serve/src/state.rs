@@ -13,7 +13,7 @@ use tendril_fbg::SpectralConfig;
 use tendril_fbg::signals::Wavelengths;
 use tendril_hyperion::{InterrogatorConfig, VirtualInterrogator};
 use tendril_rtde::{RobotOutputs, SharedInputs};
-use tendril_urscript::RtdeWatchdog;
+use tendril_urscript::{RtdeWatchdog, Setup};
 
 /// What the twin last computed (for tests and the serve printout).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,6 +79,18 @@ pub struct DeviceState {
     /// Why the arm is in a protective stop, if it is (cleared by `unlock protective stop` on the
     /// dashboard, or by a fresh program upload).
     pub protective_stop: Option<String>,
+    /// Secondary programs (`sec`) received and not started yet.
+    pub secondary_programs: std::collections::VecDeque<String>,
+    /// The controller settings the running program made (TCP, payload, gravity, ...), as the
+    /// devices report them; the defaults when no program has set them.
+    pub program_setup: Setup,
+    /// The program's sockets ([`super::sockets`]).
+    pub sockets: super::sockets::ProgramSockets,
+    /// The robot messages for the primary interface ([`super::robot_messages`]).
+    pub robot_messages: super::robot_messages::RobotMessages,
+    /// The wrench the twin's wrist sensor measures, before the program's `zero_ftsensor`
+    /// offset (`outputs.actual_tcp_force` is after it) \[N, N·m\].
+    pub tcp_force_raw: [f64; 6],
     /// Robot mode, remote control, PolyScope version, loaded program ([`super::dashboard`]).
     pub ur: UrController,
     /// The MX-106 pair.
@@ -126,6 +138,11 @@ pub fn shared_state(
         program_uploads: 0,
         program_log: std::collections::VecDeque::new(),
         protective_stop: None,
+        secondary_programs: std::collections::VecDeque::new(),
+        program_setup: Setup::default(),
+        sockets: super::sockets::ProgramSockets::default(),
+        robot_messages: super::robot_messages::RobotMessages::default(),
+        tcp_force_raw: [0.0; 6],
         ur: UrController::new(ur),
         bus,
         interrogator,

@@ -18,7 +18,7 @@ use tendril_rtde::state::{
 };
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_twin::physics::SceneModel;
-use tendril_ur5e::pose::tcp_pose;
+use tendril_ur5e::pose::{tcp_pose, tcp_speed};
 use tendril_urscript::interp::CONTROL_PERIOD_S;
 
 /// Writes what an MX-106's sensors would measure into its table: Present Position, Present
@@ -99,6 +99,12 @@ pub fn spawn(
         // The arm at the step before: RTDE reports the arm interpolated between the two.
         let mut step_before = (first.time_s, first.arm_q);
         let mut actual_qd = [0.0; ARM_JOINTS];
+        // The commanded joints at the last physics step and their speed; the TCP's twists (actual,
+        // target) at the last step and their accelerations, differenced as `actual_qd` is.
+        let mut last_target = first.arm_q;
+        let mut target_qd = [0.0; ARM_JOINTS];
+        let mut tcp_twists = ([0.0; 6], [0.0; 6]);
+        let mut tcp_accelerations = ([0.0; 6], [0.0; 6]);
         // The motors' speeds, the same way (Present Velocity).
         let mut motor_rad_s = [0.0; 2];
         let mut measured_q = first.arm_q;
@@ -125,7 +131,11 @@ pub fn spawn(
         // The devices now answer as the twin stands: `spawn` may return.
         let _ = ready.send(());
         let started = Instant::now();
-        lock(&state).program_inputs.start_clock(started);
+        {
+            let mut s = lock(&state);
+            s.program_inputs.start_clock(started);
+            s.sockets.start_clock(started);
+        }
         // Injected stalls of this thread, on the twin's clock: a tick due in one waits for its end.
         let mut stalls =
             jitter.filter(|j| j.applies_to(Link::Twin)).map(|j| DelayLine::new(j.model, j.seed, Link::Twin));
@@ -188,10 +198,20 @@ pub fn spawn(
             let r = cell.read().map_err(e)?;
             let truth = cell.ground_truth().unwrap_or_default();
             let motors_rad = [r.growth_motor_rad, r.twine_motor_rad];
+            let tcp_offset = lock(&state).outputs.tcp_offset;
             if r.time_s > last_step.0 + 1e-12 {
                 let dt = r.time_s - last_step.0;
                 actual_qd = std::array::from_fn(|j| (r.arm_q[j] - last_step.1[j]) / dt);
                 motor_rad_s = std::array::from_fn(|m| (motors_rad[m] - last_step.2[m]) / dt);
+                target_qd = std::array::from_fn(|j| (command.arm_q[j] - last_target[j]) / dt);
+                last_target = command.arm_q;
+                let twists =
+                    (tcp_speed(&r.arm_q, &actual_qd, &tcp_offset), tcp_speed(&command.arm_q, &target_qd, &tcp_offset));
+                tcp_accelerations = (
+                    std::array::from_fn(|k| (twists.0[k] - tcp_twists.0[k]) / dt),
+                    std::array::from_fn(|k| (twists.1[k] - tcp_twists.1[k]) / dt),
+                );
+                tcp_twists = twists;
                 step_before = (last_step.0, last_step.1);
                 last_step = (r.time_s, r.arm_q, motors_rad);
             }
@@ -213,6 +233,11 @@ pub fn spawn(
                 let robot_mode = s.ur.robot_mode.rtde();
                 let safety_mode =
                     if s.protective_stop.is_some() { SAFETY_MODE_PROTECTIVE_STOP } else { SAFETY_MODE_NORMAL };
+                // The wrist sensor's reading: the object's load pulls the tool down; the program's
+                // `zero_ftsensor` offset comes off what is reported.
+                let raw_force = [0.0, 0.0, -r.tool_load_n.unwrap_or(0.0), 0.0, 0.0, 0.0];
+                s.tcp_force_raw = raw_force;
+                let ft_zero = s.program_setup.ft_zero;
                 let o = &mut s.outputs;
                 o.runtime_state = runtime_state;
                 o.robot_mode = robot_mode;
@@ -222,9 +247,11 @@ pub fn spawn(
                 o.actual_q = sample_q;
                 o.target_q = command.arm_q;
                 o.actual_tcp_pose = tcp_pose(&sample_q, &o.tcp_offset);
-                // The external force on the tool: the object's load pulls it down.
-                o.actual_tcp_force = [0.0, 0.0, -r.tool_load_n.unwrap_or(0.0), 0.0, 0.0, 0.0];
+                o.actual_tcp_force = std::array::from_fn(|k| raw_force[k] - ft_zero[k]);
                 o.target_tcp_pose = tcp_pose(&command.arm_q, &o.tcp_offset);
+                o.target_qd = target_qd;
+                (o.actual_tcp_speed, o.target_tcp_speed) = tcp_twists;
+                (o.actual_tcp_acceleration, o.target_tcp_acceleration) = tcp_accelerations;
                 for (m, id) in motors.into_iter().enumerate() {
                     if let Some(t) = s.bus.table_mut(id) {
                         present_motion(t, r.time_s, motors_rad[m], motor_rad_s[m], motor_torque_nm[m]);

@@ -40,11 +40,17 @@ pub fn forward(q: &[f64; 6]) -> Isometry3<f64> {
 /// Joint angles that put the flange at `target`, found by damped least squares starting from `seed`
 /// (so the solution stays on the seed's branch). `None` when 200 iterations do not reach 0.1 mm and
 /// 1 mrad (target out of reach or singular).
+///
+/// The iterations go on to 1 nm and 1 nrad when they can, so that a target moved by less than the
+/// acceptance bound still moves the solution: a setpoint solved every control cycle along a path
+/// (`movel`, `speedl`) would otherwise stand still for cycles and then jump.
 pub fn inverse_near(target: &Isometry3<f64>, seed: &[f64; 6]) -> Option<[f64; 6]> {
+    let within =
+        |e: &Vector6<f64>, m: f64, rad: f64| e.fixed_rows::<3>(0).norm() < m && e.fixed_rows::<3>(3).norm() < rad;
     let mut q = *seed;
     for _ in 0..200 {
         let e = pose_error(target, &forward(&q));
-        if e.fixed_rows::<3>(0).norm() < 1e-4 && e.fixed_rows::<3>(3).norm() < 1e-3 {
+        if within(&e, 1e-9, 1e-9) {
             return Some(q);
         }
         // Numerical Jacobian: six forward kinematics, cheap next to a physics step.
@@ -63,7 +69,7 @@ pub fn inverse_near(target: &Isometry3<f64>, seed: &[f64; 6]) -> Option<[f64; 6]
             q[k] += dq[k].clamp(-0.2, 0.2);
         }
     }
-    None
+    within(&pose_error(target, &forward(&q)), 1e-4, 1e-3).then_some(q)
 }
 
 /// Twist-like error from `from` to `to`: position difference and rotation vector, both in the base frame.

@@ -32,6 +32,20 @@ pub fn tcp_pose(q: &[f64; 6], tcp_offset: &[f64; 6]) -> [f64; 6] {
     pose_vector(&(ur5e::forward(q) * pose_from_vector(tcp_offset)))
 }
 
+/// The TCP's twist for joint angles `q` \[rad\] moving at `qd` \[rad/s\] with a TCP offset:
+/// `[vx, vy, vz, wx, wy, wz]` in the base frame (m/s, rad/s), as `actual_TCP_speed` gives it.
+/// The forward kinematics differenced over a 1 µs step along `qd` (its error is that step times the
+/// twist's rate of change, far below the digits RTDE clients read).
+pub fn tcp_speed(q: &[f64; 6], qd: &[f64; 6], tcp_offset: &[f64; 6]) -> [f64; 6] {
+    const H: f64 = 1e-6;
+    let offset = pose_from_vector(tcp_offset);
+    let a = ur5e::forward(q) * offset;
+    let b = ur5e::forward(&std::array::from_fn(|j| q[j] + qd[j] * H)) * offset;
+    let v = (b.translation.vector - a.translation.vector) / H;
+    let w = (b.rotation * a.rotation.inverse()).scaled_axis() / H;
+    [v.x, v.y, v.z, w.x, w.y, w.z]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,6 +118,20 @@ mod tests {
         let zero = tcp_pose(&[0.0; 6], &[0.0; 6]);
         assert!((zero[0] - (A2 + A3)).abs() < 1e-12 && (zero[1] + D4 + D6).abs() < 1e-12);
         assert!((zero[2] - (D1 - D5)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_tcp_speed_of_a_base_rotation_is_omega_cross_r() {
+        // Joint 0 turns the whole arm about the base's z axis: v = ω × r, ω = (0, 0, w).
+        let q = [-PI / 2.0, -PI / 2.0, PI / 2.0, -PI / 2.0, -PI / 2.0, 0.0];
+        let w = 0.3;
+        let p = tcp_pose(&q, &[0.0; 6]);
+        let s = tcp_speed(&q, &[w, 0.0, 0.0, 0.0, 0.0, 0.0], &[0.0; 6]);
+        let expected = [-w * p[1], w * p[0], 0.0, 0.0, 0.0, w];
+        for k in 0..6 {
+            assert!((s[k] - expected[k]).abs() < 1e-5, "{s:?} vs {expected:?}");
+        }
+        assert_eq!(tcp_speed(&q, &[0.0; 6], &[0.0; 6]), [0.0; 6]);
     }
 
     #[test]

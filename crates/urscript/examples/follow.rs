@@ -31,6 +31,12 @@ impl Controller for Host {
     fn actual_q(&self) -> [f64; 6] {
         self.q
     }
+    fn actual_qd(&self) -> [f64; 6] {
+        [0.0; 6]
+    }
+    fn actual_tcp_force(&self) -> [f64; 6] {
+        [0.0; 6]
+    }
     fn input_packages(&self) -> u64 {
         self.packages
     }

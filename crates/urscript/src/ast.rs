@@ -116,6 +116,9 @@ pub struct FuncDef {
     pub body: Vec<Stmt>,
     /// `thread` rather than `def`.
     pub is_thread: bool,
+    /// A secondary program (`sec name():`, the outermost definition only): it runs beside the
+    /// main program and may not consume time.
+    pub secondary: bool,
     /// Line of the header.
     pub line: u32,
 }

@@ -2,95 +2,24 @@
 //! and defaults). Anything else is a runtime error naming the function, as a controller rejects a
 //! program calling an unknown function. The list is in `docs/cell/urscript.md`.
 
-use super::controller::{Controller, DigitalOut};
-use super::motion::Arm;
+use super::call::{Args, Cx, JOINT_HISTORY_CYCLES, Outcome};
+use super::controller::DigitalOut;
+use super::motion::{Arm, KILL_DECEL_RAD_S2};
+use super::setup;
 use super::value::Value;
 use crate::watchdog::{RtdeWatchdog, WatchdogAction};
 use tendril_rtde::fields::REGISTER_COUNT;
-use tendril_ur5e::kinematics as ur5e;
-use tendril_ur5e::pose::{pose_from_vector, pose_vector, tcp_pose};
+use tendril_ur5e::pose::{pose_from_vector, pose_vector, tcp_pose, tcp_speed};
 
-/// What a built-in gives back.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Outcome {
-    /// A value, at once.
-    Value(Value),
-    /// A value, after waiting this long \[s\] (`sync`, `sleep`, `servoj`, `speedj`).
-    Sleep(Value, f64),
-    /// A value, once this motion is over (`movej`, `movel`, `stopj`).
-    Move(Value, u64),
-}
-
-/// What a built-in may touch.
-pub struct Cx<'a> {
-    /// The controller around the interpreter.
-    pub host: &'a mut dyn Controller,
-    /// The motion generator.
-    pub arm: &'a mut Arm,
-    /// Twin time \[s\].
-    pub now: f64,
-    /// The calling thread.
-    pub thread: u64,
-    /// The controller cycle \[s\].
-    pub period: f64,
-}
-
-/// Positional and keyword arguments of one call.
-struct Args<'a> {
-    name: &'a str,
-    pos: &'a [Value],
-    kw: &'a [(String, Value)],
-}
-
-impl Args<'_> {
-    /// Checks the call against the parameter list (in order).
-    fn check(&self, params: &[&str]) -> Result<(), String> {
-        if self.pos.len() > params.len() {
-            return Err(format!("{} takes at most {} arguments, {} given", self.name, params.len(), self.pos.len()));
-        }
-        for (k, _) in self.kw {
-            if !params.contains(&k.as_str()) {
-                return Err(format!("{} has no parameter `{k}`", self.name));
-            }
-        }
-        Ok(())
-    }
-
-    fn get(&self, i: usize, key: &str) -> Option<&Value> {
-        self.pos.get(i).or_else(|| self.kw.iter().find(|(k, _)| k == key).map(|(_, v)| v))
-    }
-
-    fn value(&self, i: usize, key: &str) -> Result<&Value, String> {
-        self.get(i, key).ok_or_else(|| format!("{}: missing argument `{key}`", self.name))
-    }
-
-    fn num(&self, i: usize, key: &str) -> Result<f64, String> {
-        self.value(i, key)?.num(&format!("{}'s `{key}`", self.name))
-    }
-
-    fn num_or(&self, i: usize, key: &str, default: f64) -> Result<f64, String> {
-        match self.get(i, key) {
-            Some(v) => v.num(&format!("{}'s `{key}`", self.name)),
-            None => Ok(default),
-        }
-    }
-
-    fn six(&self, i: usize, key: &str) -> Result<[f64; 6], String> {
-        self.value(i, key)?.six(&format!("{}'s `{key}`", self.name))
-    }
-
-    fn index(&self, i: usize, key: &str, count: usize) -> Result<usize, String> {
-        let v = self.num(i, key)?;
-        if v < 0.0 || v.fract() != 0.0 || v >= count as f64 {
-            return Err(format!("{}: index {v} is not in 0..{}", self.name, count - 1));
-        }
-        Ok(v as usize)
-    }
-
-    fn boolean(&self, i: usize, key: &str) -> Result<bool, String> {
-        self.value(i, key)?.truthy()
-    }
-}
+/// The force the tool must meet against its motion before `tool_contact` reports a contact \[N\],
+/// averaged over [`TOOL_CONTACT_WINDOW`] cycles. UR does not publish its detector (it compares
+/// expected and measured joint currents); ours compares the wrist sensor's force with the
+/// direction the TCP moves. 5 N: a firm touch, below a UR5e's default protective-stop force
+/// (150 N); averaged over 25 readings the twin's wrist noise (1.75 N a reading, `[wrist]`) is
+/// 0.35 N, so noise alone never reaches it (14 standard deviations).
+pub const TOOL_CONTACT_FORCE_N: f64 = 5.0;
+/// Cycles the wrist force is averaged over for `tool_contact` (50 ms).
+pub const TOOL_CONTACT_WINDOW: usize = 25;
 
 fn float(v: f64) -> Value {
     Value::Float(v)
@@ -112,17 +41,54 @@ fn finite6(name: &str, v: [f64; 6]) -> Result<[f64; 6], String> {
 /// near the current setpoint, as `get_inverse_kin` does). Joint targets are not checked here:
 /// a non-finite or out-of-range one reaches the safety check and ends in a protective stop, as on
 /// the controller.
-fn joints_of(name: &str, v: &Value, near: &[f64; 6]) -> Result<[f64; 6], String> {
+fn joints_of(name: &str, v: &Value, arm: &Arm, near: &[f64; 6]) -> Result<[f64; 6], String> {
     match v {
-        Value::Pose(p) => ur5e::inverse_near(&pose_from_vector(&finite6(name, *p)?), near)
+        Value::Pose(p) => arm
+            .joints_for(&pose_from_vector(&finite6(name, *p)?), near)
             .ok_or_else(|| format!("{name}: no joint solution for {v}")),
         other => other.six(&format!("{name}'s target")),
     }
 }
 
+/// A TCP pose given as a pose, or as joints whose TCP it is (`movel(q)`, `movec` via joints).
+fn pose_of(name: &str, v: &Value, arm: &Arm) -> Result<[f64; 6], String> {
+    match v {
+        Value::Pose(p) => finite6(name, *p),
+        other => Ok(pose_vector(&arm.tcp_at(&finite6(name, other.six(&format!("{name}'s target"))?)?))),
+    }
+}
+
+/// Builtins that consume time or move the arm: a secondary program may not call them.
+const TIMED: [&str; 18] = [
+    "sync",
+    "sleep",
+    "movej",
+    "movel",
+    "movep",
+    "movec",
+    "servoj",
+    "speedj",
+    "speedl",
+    "stopj",
+    "stopl",
+    "socket_open",
+    "socket_read_binary_integer",
+    "socket_read_byte_list",
+    "freedrive_mode",
+    "end_freedrive_mode",
+    "force_mode",
+    "tool_contact",
+];
+
 /// Calls built-in `name`.
 pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) -> Result<Outcome, String> {
-    let a = Args { name, pos, kw };
+    let a = Args::new(name, pos, kw);
+    if cx.secondary && TIMED.contains(&name) {
+        return Err(format!("`{name}` consumes time or moves the arm: a secondary program may not call it"));
+    }
+    if let Some(outcome) = super::sockets::call(&a, cx) {
+        return outcome;
+    }
     use Outcome::Value as V;
     let math1 = |f: fn(f64) -> f64| -> Result<Outcome, String> {
         a.check(&["f"])?;
@@ -154,26 +120,48 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
         // --- Motion ---
         "movej" => {
             a.check(&["q", "a", "v", "t", "r"])?;
-            let target = joints_of(name, a.value(0, "q")?, &cx.arm.target_q())?;
+            let target = joints_of(name, a.value(0, "q")?, cx.arm, &cx.arm.target_q())?;
             let acc = positive(name, "a", a.num_or(1, "a", 1.4)?)?;
             let vel = positive(name, "v", a.num_or(2, "v", 1.05)?)?;
             let t = duration(name, a.num_or(3, "t", 0.0)?)?;
             Ok(Outcome::Move(Value::Void, cx.arm.movej(target, acc, vel, t, cx.thread)))
         }
-        "movel" => {
-            a.check(&["pose", "a", "v", "t", "r"])?;
-            let target = match a.value(0, "pose")? {
-                Value::Pose(p) => *p,
-                other => tcp_pose(&finite6(name, other.six("movel's target")?)?, &[0.0; 6]),
-            };
+        "movel" | "movep" => {
+            // Blends (`r`) are not modelled: each move ends at rest on its target.
+            let params: &[&str] =
+                if name == "movel" { &["pose", "a", "v", "t", "r"] } else { &["pose", "a", "v", "r"] };
+            a.check(params)?;
+            let target = pose_of(name, a.value(0, "pose")?, cx.arm)?;
             let acc = positive(name, "a", a.num_or(1, "a", 1.2)?)?;
             let vel = positive(name, "v", a.num_or(2, "v", 0.25)?)?;
-            let t = duration(name, a.num_or(3, "t", 0.0)?)?;
+            let t = if name == "movel" { duration(name, a.num_or(3, "t", 0.0)?)? } else { 0.0 };
             Ok(Outcome::Move(Value::Void, cx.arm.movel(target, acc, vel, t, cx.thread)?))
+        }
+        "movec" => {
+            a.check(&["pose_via", "pose_to", "a", "v", "r", "mode"])?;
+            let via = pose_of(name, a.value(0, "pose_via")?, cx.arm)?;
+            let to = pose_of(name, a.value(1, "pose_to")?, cx.arm)?;
+            let acc = positive(name, "a", a.num_or(2, "a", 1.2)?)?;
+            let vel = positive(name, "v", a.num_or(3, "v", 0.25)?)?;
+            let fixed = match a.num_or(5, "mode", 0.0)? {
+                0.0 => false,
+                1.0 => true,
+                m => return Err(format!("movec: mode must be 0 (unconstrained) or 1 (fixed), got {m}")),
+            };
+            Ok(Outcome::Move(Value::Void, cx.arm.movec(via, to, acc, vel, fixed, cx.thread)?))
+        }
+        "speedl" => {
+            a.check(&["xd", "a", "t", "aRot"])?;
+            let xd = finite6(name, a.six(0, "xd")?)?;
+            let acc = positive(name, "a", a.num(1, "a")?)?;
+            let t = a.num_or(2, "t", cx.period)?.max(cx.period);
+            let a_rot = positive(name, "aRot", a.num_or(3, "aRot", acc)?)?;
+            cx.arm.speedl(xd, acc, a_rot, cx.now + t, cx.thread);
+            Ok(Outcome::Sleep(Value::Void, t))
         }
         "servoj" => {
             a.check(&["q", "a", "v", "t", "lookahead_time", "gain"])?;
-            let q = joints_of(name, a.value(0, "q")?, &cx.arm.target_q())?;
+            let q = joints_of(name, a.value(0, "q")?, cx.arm, &cx.arm.target_q())?;
             let t = a.num_or(3, "t", 0.002)?;
             if !(t.is_finite() && t >= 0.0) {
                 return Err(format!("servoj: t must be non-negative, got {t}"));
@@ -201,9 +189,41 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             Ok(Outcome::Move(Value::Void, cx.arm.stopj(decel, cx.thread)))
         }
         // --- Robot state ---
-        "get_actual_joint_positions" => {
+        // `get_joint_positions` is the manual's older name of the measured joints.
+        "get_actual_joint_positions" | "get_joint_positions" => {
             a.check(&[])?;
             Ok(V(Value::list6(cx.host.actual_q())))
+        }
+        "get_actual_joint_speeds" => {
+            a.check(&[])?;
+            Ok(V(Value::list6(cx.host.actual_qd())))
+        }
+        "get_actual_joint_positions_history" => {
+            a.check(&["steps"])?;
+            let steps = a.num_or(0, "steps", 0.0)?;
+            let k = steps as usize;
+            if steps.fract() != 0.0 || steps < 0.0 || k >= JOINT_HISTORY_CYCLES {
+                return Err(format!("{name}: steps must be an integer in 0..{}, got {steps}", JOINT_HISTORY_CYCLES));
+            }
+            let q = cx.history.get(k).or(cx.history.back()).map_or_else(|| cx.host.actual_q(), |m| m.q);
+            Ok(V(Value::list6(q)))
+        }
+        "get_actual_tcp_speed" => {
+            a.check(&[])?;
+            Ok(V(Value::Pose(tcp_speed(&cx.host.actual_q(), &cx.host.actual_qd(), &cx.setup.tcp))))
+        }
+        "get_target_tcp_speed" => {
+            a.check(&[])?;
+            Ok(V(Value::Pose(tcp_speed(&cx.arm.target_q(), &cx.arm.target_qd(), &cx.setup.tcp))))
+        }
+        "get_tcp_force" => {
+            a.check(&[])?;
+            let f = cx.host.actual_tcp_force();
+            Ok(V(Value::Pose(std::array::from_fn(|k| f[k] - cx.setup.ft_zero[k]))))
+        }
+        "get_tcp_offset" => {
+            a.check(&[])?;
+            Ok(V(Value::Pose(cx.setup.tcp)))
         }
         "get_target_joint_positions" => {
             a.check(&[])?;
@@ -215,11 +235,11 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
         }
         "get_actual_tcp_pose" => {
             a.check(&[])?;
-            Ok(V(Value::Pose(tcp_pose(&cx.host.actual_q(), &[0.0; 6]))))
+            Ok(V(Value::Pose(tcp_pose(&cx.host.actual_q(), &cx.setup.tcp))))
         }
         "get_target_tcp_pose" => {
             a.check(&[])?;
-            Ok(V(Value::Pose(tcp_pose(&cx.arm.target_q(), &[0.0; 6]))))
+            Ok(V(Value::Pose(tcp_pose(&cx.arm.target_q(), &cx.setup.tcp))))
         }
         "get_forward_kin" => {
             a.check(&["q", "tcp"])?;
@@ -229,7 +249,7 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             };
             let tcp = match a.get(1, "tcp") {
                 Some(v) => v.six("get_forward_kin's tcp")?,
-                None => [0.0; 6],
+                None => cx.setup.tcp,
             };
             Ok(V(Value::Pose(tcp_pose(&q, &tcp))))
         }
@@ -240,7 +260,8 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
                 Some(v) => finite6(name, v.six("get_inverse_kin's qnear")?)?,
                 None => cx.host.actual_q(),
             };
-            ur5e::inverse_near(&pose_from_vector(&x), &near)
+            cx.arm
+                .joints_for(&pose_from_vector(&x), &near)
                 .map(|q| V(Value::list6(q)))
                 .ok_or_else(|| format!("get_inverse_kin: no solution for p{x:?}"))
         }
@@ -251,7 +272,7 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
                 Some(v) => v.six("qnear")?,
                 None => cx.host.actual_q(),
             };
-            Ok(V(Value::Bool(ur5e::inverse_near(&pose_from_vector(&x), &near).is_some())))
+            Ok(V(Value::Bool(cx.arm.joints_for(&pose_from_vector(&x), &near).is_some())))
         }
         // --- RTDE registers ---
         "read_input_integer_register" => {
@@ -341,6 +362,88 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             }
             Ok(V(Value::Void))
         }
+        // --- Controller settings (`Setup`) ---
+        "set_tcp" => {
+            a.check(&["pose"])?;
+            let tcp = finite6(name, a.six(0, "pose")?)?;
+            cx.setup.tcp = tcp;
+            cx.arm.set_tcp(&tcp);
+            Ok(V(Value::Void))
+        }
+        "set_payload" => {
+            a.check(&["m", "cog"])?;
+            cx.setup.payload_kg = setup::payload_mass(name, a.num(0, "m")?)?;
+            if let Some(cog) = a.get(1, "cog") {
+                cx.setup.payload_cog = setup::three(name, "cog", cog)?;
+            }
+            Ok(V(Value::Void))
+        }
+        "set_payload_mass" => {
+            a.check(&["m"])?;
+            cx.setup.payload_kg = setup::payload_mass(name, a.num(0, "m")?)?;
+            Ok(V(Value::Void))
+        }
+        "set_payload_cog" => {
+            a.check(&["CoG"])?;
+            cx.setup.payload_cog = setup::three(name, "CoG", a.value(0, "CoG")?)?;
+            Ok(V(Value::Void))
+        }
+        "set_target_payload" => {
+            a.check(&["mass", "cog", "inertia", "transition_time"])?;
+            cx.setup.payload_kg = setup::payload_mass(name, a.num(0, "mass")?)?;
+            cx.setup.payload_cog = setup::three(name, "cog", a.value(1, "cog")?)?;
+            if let Some(i) = a.get(2, "inertia") {
+                cx.setup.payload_inertia = finite6(name, i.six("set_target_payload's inertia")?)?;
+            }
+            // The transition time smooths the change on the controller; the twin's physics does
+            // not read the payload, so it has nothing to smooth.
+            duration(name, a.num_or(3, "transition_time", 0.0)?)?;
+            Ok(V(Value::Void))
+        }
+        "set_gravity" => {
+            a.check(&["d"])?;
+            cx.setup.gravity = setup::three(name, "d", a.value(0, "d")?)?;
+            Ok(V(Value::Void))
+        }
+        "set_tool_voltage" => {
+            a.check(&["voltage"])?;
+            let v = a.num(0, "voltage")?;
+            if ![0.0, 12.0, 24.0].contains(&v) {
+                return Err(format!("{name}: voltage must be 0, 12 or 24, got {v}"));
+            }
+            cx.setup.tool_voltage = v as i32;
+            Ok(V(Value::Void))
+        }
+        "zero_ftsensor" => {
+            a.check(&[])?;
+            cx.setup.ft_zero = cx.host.actual_tcp_force();
+            Ok(V(Value::Void))
+        }
+        "freedrive_mode" => {
+            // Nobody pushes the twin's arm, so in freedrive it stays where it is, as a real arm in
+            // freedrive does when nobody touches it; the program goes on (the mode is reported).
+            a.check(&["freeAxes", "feature"])?;
+            cx.setup.freedrive = true;
+            Ok(Outcome::Move(Value::Void, cx.arm.stopj(KILL_DECEL_RAD_S2, cx.thread)))
+        }
+        "end_freedrive_mode" => {
+            a.check(&[])?;
+            cx.setup.freedrive = false;
+            Ok(V(Value::Void))
+        }
+        "force_mode" => Err("force_mode is not supported by the virtual controller: the twin's arm follows position \
+             setpoints and has no force control loop to comply with a wrench"
+            .into()),
+        // Nothing to end: force mode never starts here (the controller accepts the call then too).
+        "end_force_mode" => {
+            a.check(&[])?;
+            Ok(V(Value::Void))
+        }
+        "tool_contact" => {
+            a.check(&["direction"])?;
+            let d = finite6(name, a.six(0, "direction")?)?;
+            Ok(V(Value::Int(tool_contact_steps(cx, &d))))
+        }
         // --- Messages ---
         "textmsg" => {
             a.check(&["s1", "s2"])?;
@@ -349,6 +452,7 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
             Ok(V(Value::Void))
         }
         "popup" => {
+            // Logged; a blocking popup does not wait for a user the virtual controller has not.
             a.check(&["s", "title", "warning", "error", "blocking"])?;
             cx.host.message(&format!("popup: {}", a.value(0, "s")?));
             Ok(V(Value::Void))
@@ -474,4 +578,30 @@ pub fn call(name: &str, pos: &[Value], kw: &[(String, Value)], cx: &mut Cx<'_>) 
         }
         _ => Err(format!("`{name}` is not supported by the virtual controller")),
     }
+}
+
+/// `tool_contact(direction)`: the cycles back to before the contact began, 0 without one. A
+/// contact is the wrist sensor's force (less its `zero_ftsensor` offset), averaged over the last
+/// [`TOOL_CONTACT_WINDOW`] cycles, pushing back against the TCP's direction of motion by more than
+/// [`TOOL_CONTACT_FORCE_N`]. The cycles back reach past the newest window whose average was below a
+/// quarter of that by one window more, so the pose they name is before the contact (by at most
+/// 50 ms of motion).
+fn tool_contact_steps(cx: &Cx<'_>, direction: &[f64; 6]) -> i64 {
+    let v = nalgebra::Vector3::new(direction[0], direction[1], direction[2]);
+    let Some(unit) = v.try_normalize(1e-9) else { return 0 };
+    let zero = cx.setup.ft_zero;
+    let push: Vec<f64> = cx
+        .history
+        .iter()
+        .map(|m| -nalgebra::Vector3::new(m.force[0] - zero[0], m.force[1] - zero[1], m.force[2] - zero[2]).dot(&unit))
+        .collect();
+    let mean_from = |k: usize| {
+        let window = &push[k..(k + TOOL_CONTACT_WINDOW).min(push.len())];
+        window.iter().sum::<f64>() / window.len() as f64
+    };
+    if push.len() < TOOL_CONTACT_WINDOW || mean_from(0) <= TOOL_CONTACT_FORCE_N {
+        return 0;
+    }
+    let before = (0..push.len()).find(|&k| mean_from(k) < 0.25 * TOOL_CONTACT_FORCE_N).unwrap_or(push.len());
+    (before + TOOL_CONTACT_WINDOW).min(push.len() - 1) as i64
 }

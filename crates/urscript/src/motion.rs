@@ -3,12 +3,24 @@
 //!
 //! - `movej(q, a, v, t)`: a trapezoidal speed profile in joint space; every joint starts and stops
 //!   together, the one with the farthest to go at speed `v` (rad/s) and acceleration `a` (rad/s²)
-//!   (`t` > 0 stretches it to that duration). UR's controller also uses such a synchronised
+//!   (`t` > 0 scales it in time to last exactly `t`, `a` and `v` then ignored, as the manual
+//!   says). UR's controller also uses such a synchronised
 //!   trapezoid; its exact blend of jerk limits is not modelled.
 //! - `movel(pose, a, v, t)`: the same profile over the straight path of the TCP (m/s, m/s²): the
 //!   position interpolated linearly, the orientation along the shortest rotation; each cycle's
 //!   pose turned into joints by [`ur5e::inverse_near`] from the previous setpoint (so the arm stays
-//!   on its branch). A pose it cannot reach is an error.
+//!   on its branch). A pose it cannot reach is an error. `movep` is the same move (its blends,
+//!   which keep the tool speed constant through waypoints, are not modelled, so one `movep` is a
+//!   `movel` with the same profile).
+//! - `movec(via, to, a, v, mode)`: the same profile along the circle through the TCP, `via` and
+//!   `to`; the orientation goes from the start's to `to`'s along the shortest rotation (mode 0,
+//!   unconstrained), or turns with the circle's tangent (mode 1, fixed).
+//! - `speedl(xd, a, t)`: the TCP twist ramped towards `xd` at `a` (m/s², rad/s² for the rotation),
+//!   integrated every cycle into a TCP pose whose joints come from [`ur5e::inverse_near`]; as
+//!   `speedj`, it decelerates once not renewed.
+//!
+//! Poses are the TCP's: the program's TCP offset (`set_tcp`, [`Arm::set_tcp`]) lies between the
+//! flange the kinematics give and the pose a program names.
 //! - `servoj(q, t=...)`: the target itself. The arm is commanded when the target changes or an RTDE
 //!   input package arrived since the last command: the twin's kinematic arm spreads a move over the
 //!   time since the command before, so a target streamed over RTDE is followed at the client's
@@ -24,11 +36,13 @@
 //!
 //! Speeds are capped at the UR5e's joint speed (π rad/s), the protective-stop limit.
 
-use nalgebra::{Isometry3, Translation3};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use tendril_ur5e::kinematics as ur5e;
 use tendril_ur5e::pose::{pose_from_vector, pose_vector};
 use tendril_ur5e::safety::MAX_JOINT_SPEED_RAD_S;
 
+/// Deceleration when a moving thread is killed, or the arm is put in freedrive \[rad/s²\].
+pub const KILL_DECEL_RAD_S2: f64 = 4.0;
 /// Lever that turns a tool acceleration into a joint one for `stopl` \[m\].
 pub const STOPL_LEVER_M: f64 = 0.5;
 
@@ -45,9 +59,10 @@ pub struct Profile {
 }
 
 impl Profile {
-    /// The profile over `dist` (≥ 0) at top speed `v` and acceleration `a` (both > 0), stretched
-    /// to `min_time` \[s\] if that is longer.
-    pub fn new(dist: f64, v: f64, a: f64, min_time: f64) -> Profile {
+    /// The profile over `dist` (≥ 0) at top speed `v` and acceleration `a` (both > 0); a time
+    /// `t` \[s\] > 0 makes it last exactly that long, its shape scaled in time (URScript's `t`:
+    /// "the speed and acceleration are then ignored").
+    pub fn new(dist: f64, v: f64, a: f64, t: f64) -> Profile {
         let (v, a) = (v.max(1e-9), a.max(1e-9));
         let (t_acc, total, v) = if dist * a < v * v {
             let t = (dist / a).sqrt();
@@ -55,7 +70,7 @@ impl Profile {
         } else {
             (v / a, dist / v + v / a, v)
         };
-        let stretch = if min_time > total && total > 0.0 { min_time / total } else { 1.0 };
+        let stretch = if t > 0.0 && total > 0.0 { t / total } else { 1.0 };
         Profile { dist, v, a, t_acc, total, stretch }
     }
 
@@ -82,14 +97,73 @@ impl Profile {
     }
 }
 
+/// The TCP's path for a Cartesian move.
+#[derive(Debug, Clone, PartialEq)]
+enum Path {
+    /// A straight line, the orientation along the shortest rotation.
+    Line { from: Isometry3<f64>, to: Isometry3<f64> },
+    /// An arc of `angle` about `axis` through `centre`, starting at `from`; the orientation goes to
+    /// `to_rotation`, or (fixed mode, `None`) turns with the arc.
+    Arc {
+        from: Isometry3<f64>,
+        centre: Vector3<f64>,
+        axis: nalgebra::Unit<Vector3<f64>>,
+        angle: f64,
+        to_rotation: Option<UnitQuaternion<f64>>,
+    },
+}
+
+impl Path {
+    /// The TCP pose a fraction `f` of the way along.
+    fn at(&self, f: f64) -> Isometry3<f64> {
+        match self {
+            Path::Line { from, to } => {
+                let p = from.translation.vector.lerp(&to.translation.vector, f);
+                Isometry3::from_parts(Translation3::from(p), from.rotation.slerp(&to.rotation, f))
+            }
+            Path::Arc { from, centre, axis, angle, to_rotation } => {
+                let turn = UnitQuaternion::from_axis_angle(axis, angle * f);
+                let p = centre + turn * (from.translation.vector - centre);
+                let r = match to_rotation {
+                    Some(to) => from.rotation.slerp(to, f),
+                    None => turn * from.rotation,
+                };
+                Isometry3::from_parts(Translation3::from(p), r)
+            }
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 enum Motion {
     Hold,
-    Joint { from: [f64; 6], to: [f64; 6], profile: Profile, start: f64 },
-    Linear { from: Isometry3<f64>, to: Isometry3<f64>, profile: Profile, start: f64 },
+    Joint {
+        from: [f64; 6],
+        to: [f64; 6],
+        profile: Profile,
+        start: f64,
+    },
+    Cartesian {
+        path: Path,
+        profile: Profile,
+        start: f64,
+    },
     Servo,
-    Speed { target: [f64; 6], accel: f64, until: f64 },
-    Stop { decel: f64 },
+    Speed {
+        target: [f64; 6],
+        accel: f64,
+        until: f64,
+    },
+    /// `speedl`: the TCP twist now, the one aimed at, the accelerations (linear, rotational).
+    SpeedL {
+        twist: [f64; 6],
+        target: [f64; 6],
+        accel: (f64, f64),
+        until: f64,
+    },
+    Stop {
+        decel: f64,
+    },
 }
 
 /// The commanded arm: setpoint, its speed, and the motion producing it.
@@ -107,6 +181,8 @@ pub struct Arm {
     servo_sent: Option<([f64; 6], u64)>,
     /// A setpoint to command this cycle.
     pending: Option<[f64; 6]>,
+    /// The TCP offset from the flange (`set_tcp`).
+    tcp: Isometry3<f64>,
 }
 
 fn norm(v: &[f64; 6]) -> f64 {
@@ -120,7 +196,32 @@ fn max_abs(v: &[f64; 6]) -> f64 {
 impl Arm {
     /// An arm at rest at `q` \[rad\].
     pub fn new(q: [f64; 6]) -> Arm {
-        Arm { q, qd: [0.0; 6], motion: Motion::Hold, id: 0, done: true, owner: None, servo_sent: None, pending: None }
+        Arm {
+            q,
+            qd: [0.0; 6],
+            motion: Motion::Hold,
+            id: 0,
+            done: true,
+            owner: None,
+            servo_sent: None,
+            pending: None,
+            tcp: Isometry3::identity(),
+        }
+    }
+
+    /// Sets the TCP offset from the flange (`[x, y, z, rx, ry, rz]`, m and rad).
+    pub fn set_tcp(&mut self, offset: &[f64; 6]) {
+        self.tcp = pose_from_vector(offset);
+    }
+
+    /// The TCP pose at joint angles `q`.
+    pub fn tcp_at(&self, q: &[f64; 6]) -> Isometry3<f64> {
+        ur5e::forward(q) * self.tcp
+    }
+
+    /// Joint angles near `near` that put the TCP at `pose`, if the arm reaches it.
+    pub fn joints_for(&self, pose: &Isometry3<f64>, near: &[f64; 6]) -> Option<[f64; 6]> {
+        ur5e::inverse_near(&(pose * self.tcp.inverse()), near)
     }
 
     /// The setpoint \[rad\] (`get_target_joint_positions`).
@@ -171,18 +272,70 @@ impl Arm {
         self.begin(Motion::Joint { from: self.q, to, profile, start: f64::NAN }, owner)
     }
 
-    /// `movel` to a TCP pose (flange, no TCP offset); an error if the pose is not a finite pose.
+    /// `movel` (and `movep`) to a TCP pose; an error if the pose is not a finite pose.
     pub fn movel(&mut self, to: [f64; 6], a: f64, v: f64, t: f64, owner: u64) -> Result<u64, String> {
         if to.iter().any(|x| !x.is_finite()) {
             return Err(format!("movel target {to:?} is not finite"));
         }
-        let from = ur5e::forward(&self.q);
+        let from = self.tcp_at(&self.q);
         let to = pose_from_vector(&to);
         let dist = (to.translation.vector - from.translation.vector).norm();
         // A pure rotation moves along its angle instead (rad at the same numbers).
         let dist = if dist > 1e-6 { dist } else { from.rotation.angle_to(&to.rotation) };
         let profile = Profile::new(dist, v, a, t);
-        Ok(self.begin(Motion::Linear { from, to, profile, start: f64::NAN }, owner))
+        Ok(self.begin(Motion::Cartesian { path: Path::Line { from, to }, profile, start: f64::NAN }, owner))
+    }
+
+    /// `movec` through TCP pose `via` to TCP pose `to`; `fixed` keeps the orientation turning with
+    /// the arc (mode 1). An error if the three points are (nearly) on one line.
+    pub fn movec(
+        &mut self,
+        via: [f64; 6],
+        to: [f64; 6],
+        a: f64,
+        v: f64,
+        fixed: bool,
+        owner: u64,
+    ) -> Result<u64, String> {
+        if via.iter().chain(&to).any(|x| !x.is_finite()) {
+            return Err(format!("movec points {via:?}, {to:?} are not finite"));
+        }
+        let from = self.tcp_at(&self.q);
+        let (p0, to) = (from.translation.vector, pose_from_vector(&to));
+        let (p1, p2) = (Vector3::new(via[0], via[1], via[2]), to.translation.vector);
+        // The circle through three points: centre where the perpendicular bisectors meet.
+        let (u, w) = (p1 - p0, p2 - p0);
+        let n = u.cross(&w);
+        if n.norm() < 1e-9 {
+            return Err("movec: the start, via and end points are on one line".into());
+        }
+        let centre = p0 + (w.norm_squared() * n.cross(&u) + u.norm_squared() * w.cross(&n)) / (2.0 * n.norm_squared());
+        let axis = nalgebra::Unit::new_normalize(n);
+        let angle_to = |p: Vector3<f64>| {
+            let (a, b) = (p0 - centre, p - centre);
+            let ang = a.cross(&b).dot(&axis).atan2(a.dot(&b));
+            if ang < 0.0 { ang + std::f64::consts::TAU } else { ang }
+        };
+        // n = u × w points so that going from p0 towards p1 then p2 is positive about it.
+        let angle = angle_to(p2);
+        let radius = (p0 - centre).norm();
+        let to_rotation = (!fixed).then_some(to.rotation);
+        let profile = Profile::new(radius * angle, v, a, 0.0);
+        let path = Path::Arc { from, centre, axis, angle, to_rotation };
+        Ok(self.begin(Motion::Cartesian { path, profile, start: f64::NAN }, owner))
+    }
+
+    /// `speedl` towards TCP twist `xd` (m/s, rad/s) at accelerations `a` (m/s²) and `a_rot`
+    /// (rad/s²), the call returning at `until` \[s\].
+    pub fn speedl(&mut self, xd: [f64; 6], a: f64, a_rot: f64, until: f64, owner: u64) -> u64 {
+        match &mut self.motion {
+            Motion::SpeedL { target, accel, until: u, .. } if !self.done => {
+                (*target, *accel, *u) = (xd, (a, a_rot), until);
+                self.owner = Some(owner);
+                self.id
+            }
+            _ => self.begin(Motion::SpeedL { twist: [0.0; 6], target: xd, accel: (a, a_rot), until }, owner),
+        }
     }
 
     /// `servoj` to `q`; `packages` counts the RTDE input packages so far.
@@ -235,7 +388,7 @@ impl Arm {
         let (before, speed_before) = (self.q, self.qd);
         let mut moved = false;
         // Joint and linear moves: the speed is the setpoint's change over the cycle.
-        let kinematic = matches!(self.motion, Motion::Joint { .. } | Motion::Linear { .. });
+        let kinematic = matches!(self.motion, Motion::Joint { .. } | Motion::Cartesian { .. } | Motion::SpeedL { .. });
         match &mut self.motion {
             Motion::Hold | Motion::Servo => {}
             Motion::Joint { from, to, profile, start } => {
@@ -251,19 +404,45 @@ impl Arm {
                     self.done = true;
                 }
             }
-            Motion::Linear { from, to, profile, start } => {
+            Motion::Cartesian { path, profile, start } => {
                 if start.is_nan() {
                     *start = now - dt;
                 }
                 let t = now - *start;
-                let f = profile.fraction(t);
-                let p = from.translation.vector.lerp(&to.translation.vector, f);
-                let r = from.rotation.slerp(&to.rotation, f);
-                let pose = Isometry3::from_parts(Translation3::from(p), r);
-                self.q = ur5e::inverse_near(&pose, &self.q)
-                    .ok_or_else(|| format!("movel: no joint solution near the arm for {:?}", pose_vector(&pose)))?;
+                let pose = path.at(profile.fraction(t));
+                let finished = t >= profile.duration();
+                self.q = ur5e::inverse_near(&(pose * self.tcp.inverse()), &self.q)
+                    .ok_or_else(|| format!("no joint solution near the arm for the TCP at {:?}", pose_vector(&pose)))?;
                 moved = true;
-                if t >= profile.duration() {
+                if finished {
+                    self.done = true;
+                }
+            }
+            Motion::SpeedL { twist, target, accel, until } => {
+                if now > *until + 0.5 * dt {
+                    *target = [0.0; 6];
+                }
+                let before_twist = *twist;
+                // Linear and rotational parts each ramp at their acceleration.
+                for (range, a) in [(0..3, accel.0), (3..6, accel.1)] {
+                    let dv: Vec<f64> = range.clone().map(|k| target[k] - twist[k]).collect();
+                    let size = dv.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    let scale = if size > 0.0 { (a * dt / size).min(1.0) } else { 0.0 };
+                    for (k, d) in range.zip(dv) {
+                        twist[k] += d * scale;
+                    }
+                }
+                // As speedj: the twist ramps within the cycle, the way is its mean times the cycle.
+                let mean: [f64; 6] = std::array::from_fn(|k| 0.5 * (before_twist[k] + twist[k]));
+                let pose = ur5e::forward(&self.q) * self.tcp;
+                let p = pose.translation.vector + Vector3::new(mean[0], mean[1], mean[2]) * dt;
+                let r = UnitQuaternion::from_scaled_axis(Vector3::new(mean[3], mean[4], mean[5]) * dt) * pose.rotation;
+                let next = Isometry3::from_parts(Translation3::from(p), r);
+                self.q = ur5e::inverse_near(&(next * self.tcp.inverse()), &self.q).ok_or_else(|| {
+                    format!("speedl: no joint solution near the arm for the TCP at {:?}", pose_vector(&next))
+                })?;
+                moved = true;
+                if now > *until + 0.5 * dt && twist.iter().all(|v| *v == 0.0) {
                     self.done = true;
                 }
             }
@@ -275,8 +454,12 @@ impl Arm {
                 }
                 let dv: [f64; 6] = std::array::from_fn(|j| target[j] - self.qd[j]);
                 let scale = (*accel * dt / max_abs(&dv).max(1e-12)).min(1.0);
-                self.qd = std::array::from_fn(|j| self.qd[j] + dv[j] * scale);
-                self.q = std::array::from_fn(|j| self.q[j] + self.qd[j] * dt);
+                let old = self.qd;
+                self.qd = std::array::from_fn(|j| old[j] + dv[j] * scale);
+                // The speed ramps linearly within the cycle: the way is its mean times the cycle
+                // (a spline run as speedj steps, as UR's external control program runs them, then
+                // lands on its points).
+                self.q = std::array::from_fn(|j| self.q[j] + 0.5 * (old[j] + self.qd[j]) * dt);
                 moved = true;
             }
             Motion::Stop { decel } => {
@@ -331,6 +514,9 @@ mod tests {
         let short = Profile::new(0.01, 1.0, 1.0, 0.0);
         assert!((short.duration() - 0.2).abs() < 1e-12, "triangular");
         assert!((Profile::new(1.0, 0.5, 1.0, 5.0).duration() - 5.0).abs() < 1e-12, "stretched to t");
+        let fast = Profile::new(1.0, 0.5, 1.0, 1.0);
+        assert!((fast.duration() - 1.0).abs() < 1e-12, "compressed to t: a and v ignored");
+        assert!((fast.fraction(0.5) - 0.5).abs() < 1e-12);
     }
 
     #[test]

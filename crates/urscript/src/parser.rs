@@ -13,16 +13,19 @@ use super::value::{BinOp, Value};
 /// Deepest nesting of blocks and expressions accepted.
 pub const MAX_DEPTH: usize = 200;
 
-/// Parses a complete program: one `def name(): ... end` (comments and blank lines around it).
+/// Parses a complete program: one `def name(): ... end`, or a secondary program `sec name(): ...
+/// end` (comments and blank lines around it).
 pub fn parse_program(text: &str) -> Result<FuncDef, ScriptError> {
     let tokens = lex(text)?;
     let mut p = Parser { tokens, pos: 0, depth: 0 };
     p.skip_newlines();
     let line = p.line();
-    if !p.at_name("def") {
-        return Err(p.error("a program starts with `def name():`"));
+    if !p.at_name("def") && !p.at_name("sec") {
+        return Err(p.error("a program starts with `def name():` or `sec name():`"));
     }
-    let main = p.funcdef()?;
+    let secondary = p.at_name("sec");
+    let mut main = p.funcdef()?;
+    main.secondary = secondary;
     if !main.params.is_empty() {
         return Err(ScriptError { line, message: "the program's def takes no parameters".into() });
     }
@@ -151,7 +154,7 @@ impl Parser {
         self.expect_newline()?;
         let body = self.block()?;
         self.end()?;
-        Ok(FuncDef { name, params, defaults, body, is_thread, line })
+        Ok(FuncDef { name, params, defaults, body, is_thread, secondary: false, line })
     }
 
     fn end(&mut self) -> Result<(), ScriptError> {
@@ -251,6 +254,7 @@ impl Parser {
                 StmtKind::Assign { name, indices: Vec::new(), value, scope }
             }
             "sec" | "for" | "interpreter_mode" => {
+                // A `sec` inside a program is not URScript (secondary programs are sent on their own).
                 return Err(self.error(&format!("`{keyword}` is not supported by the virtual controller")));
             }
             "end" | "elif" | "else" => return Err(self.error("unexpected block end")),
