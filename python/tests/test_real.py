@@ -15,11 +15,11 @@ from test_controller import PythonPid
 
 
 def _free_port_base():
-    """Six consecutive free ports on loopback (serve's --port-base N takes N..N+5)."""
+    """Seven consecutive free ports on loopback (serve's --port-base N takes N..N+6)."""
     for base in range(43_000 + (os.getpid() % 500) * 12, 60_000, 12):
         sockets = []
         try:
-            for port in range(base, base + 6):
+            for port in range(base, base + 7):
                 s = socket.socket()
                 sockets.append(s)
                 s.bind(("127.0.0.1", port))
@@ -29,7 +29,7 @@ def _free_port_base():
         finally:
             for s in sockets:
                 s.close()
-    raise RuntimeError("no six consecutive free ports")
+    raise RuntimeError("no seven consecutive free ports")
 
 
 def _may_use_sched_fifo():

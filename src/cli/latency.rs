@@ -21,7 +21,7 @@ pub struct LatencyArgs {
     /// Control rate [Hz].
     #[arg(long, default_value_t = 500.0)]
     rate_hz: f64,
-    /// Ports of the virtual devices (N .. N+5 on 127.0.0.1).
+    /// Ports of the virtual devices (N .. N+6 on 127.0.0.1).
     #[arg(long, default_value_t = 39400, value_parser = super::devices::port_base)]
     port_base: u16,
     /// Every watchdog limit [ms] (the sensor's, the arm's and the motors'); 500 ms by default, far

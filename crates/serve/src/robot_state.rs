@@ -161,3 +161,34 @@ pub fn robot_state(s: &DeviceState) -> Package {
         SubPackage::ToolMode(ToolModeInfo { output_mode: 0, digital_output_mode_0: 1, digital_output_mode_1: 1 }),
     ])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tendril_codec::Decoded;
+
+    #[test]
+    fn the_state_carries_the_twins_joints_and_decodes_whole() {
+        let (state, _) = crate::state::shared_state(
+            &tendril_drivers::HardwareConfig::default(),
+            &tendril_fbg::SpectralConfig::default(),
+            &crate::VirtualUrSetup::default(),
+        )
+        .unwrap();
+        let mut s = state.lock().unwrap();
+        s.outputs.actual_q = ur5e::HOME;
+        s.program_setup.freedrive = true;
+        let bytes = robot_state(&s).encode().unwrap();
+        let Decoded::Frame { packet: Package::State(subs), consumed } = Package::decode(&bytes) else { panic!() };
+        assert_eq!(consumed, bytes.len());
+        assert_eq!(subs.len(), 12);
+        let SubPackage::Joints(j) = &subs[1] else { panic!("{:?}", subs[1]) };
+        assert_eq!(j.map(|j| j.q_actual), ur5e::HOME);
+        let SubPackage::RobotMode(m) = &subs[0] else { panic!() };
+        assert_eq!((m.robot_mode, m.control_mode, m.is_program_running), (7, 1, false));
+        assert_eq!(kinematics().client_library_checksum(), "calib_12788084448423163542");
+        let Package::Message(v) = version(&s) else { panic!() };
+        let RobotMessage::Version(v) = v.body else { panic!() };
+        assert_eq!((v.major, v.minor, v.bugfix, v.build, v.build_date.as_str()), (5, 11, 1, 108318, "Mar 23 2021"));
+    }
+}

@@ -236,3 +236,47 @@ async fn connection(
     let mut l = lock(&link);
     l.peer_closed = true;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn loopback_and_the_allowed_hosts_only_and_no_names_but_localhost() {
+        let mut s = ProgramSockets::default();
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        assert!(s.open("a", "127.0.0.1", 9, 0.0).unwrap_err().contains("no network"), "not attached yet");
+        s.attach(runtime.handle().clone(), vec!["192.0.2.7".parse().unwrap()]);
+        for host in ["127.0.0.1", "127.1.2.3", "::1", "localhost", "192.0.2.7"] {
+            assert_eq!(s.address(host).map(|_| ()), Ok(()), "{host}");
+        }
+        let refused = s.address("192.0.2.8").unwrap_err();
+        assert!(refused.contains("not an allowed host") && refused.contains("--allow-host 192.0.2.8"), "{refused}");
+        assert!(s.address("driver.local").unwrap_err().contains("resolves no host names"));
+        // Opening is asynchronous: the socket connects on the runtime, the caller only looks.
+        s.open("a", "127.0.0.1", 9, 0.0).unwrap();
+        assert_eq!(s.count(), 1);
+        s.close_all();
+        assert_eq!((s.count(), s.state("a")), (0, SocketState::Closed));
+    }
+
+    #[test]
+    fn bytes_are_readable_from_the_twin_time_they_arrived_at_and_whole() {
+        let mut s = ProgramSockets::default();
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        s.attach(runtime.handle().clone(), Vec::new());
+        s.open("a", "127.0.0.1", 9, 0.0).unwrap();
+        {
+            let link = &s.open["a"].link;
+            let mut l = lock(link);
+            l.state = SocketState::Open;
+            l.arrived.push_back((0.010, vec![1, 2, 3]));
+            l.arrived.push_back((0.020, vec![4, 5]));
+        }
+        assert_eq!(s.read("a", 2, 0.005), None, "not yet arrived at 5 ms");
+        assert_eq!(s.read("a", 4, 0.012), None, "only three bytes by 12 ms");
+        assert_eq!(s.read("a", 2, 0.012), Some(vec![1, 2]));
+        assert_eq!(s.read("a", 3, 0.020), Some(vec![3, 4, 5]));
+        assert_eq!(s.read("nope", 1, 1.0), None);
+    }
+}
