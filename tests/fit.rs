@@ -355,3 +355,52 @@ fn a_candidate_whose_run_fails_scores_as_failed_and_the_fit_goes_on() {
     let report = fit_json(&out);
     assert_eq!(report["evaluations"].as_u64(), Some(records.len() as u64));
 }
+
+#[test]
+fn a_runs_bag_is_read_as_its_trace_and_fitted_to_the_same_values() {
+    let dir = tempfile::tempdir().unwrap();
+    record(&dir.path().join("on"), "on", &["--bag"]);
+    let csv = tendril::fit::recording::Recording::read(&dir.path().join("on")).unwrap();
+    let spec = tendril::fit::bag::BagSpec {
+        path: "on/bag".into(),
+        scenario: "on/scenario.toml".into(),
+        name: None,
+        topics: Default::default(),
+        outcome: csv.events.outcome.clone(),
+        drop_cell_time_s: csv.events.drop_cell_time_s,
+        drop_phase: csv.events.drop_phase.clone(),
+    };
+    let bag = tendril::fit::bag::read_bag_recording(dir.path(), &spec).unwrap();
+    assert_eq!(bag.name, "on", "a run's bag is named after its run");
+    assert_eq!(bag.ticks.len(), csv.ticks.len());
+    // trace.csv rounds time to 0.1 ms and forces and angles to 10 µN and 10 µrad; the bag does not.
+    for (b, c) in bag.ticks.iter().zip(&csv.ticks) {
+        assert_eq!(b.phase, c.phase);
+        assert!((b.time_s - c.time_s).abs() <= 5.1e-5, "{b:?} {c:?}");
+        assert!((b.force_n - c.force_n).abs() <= 5.1e-6, "{b:?} {c:?}");
+        assert!((b.twine_motor_rad - c.twine_motor_rad).abs() <= 5.1e-6, "{b:?} {c:?}");
+    }
+    // The same fit, on the folder and on its bag.
+    let on_csv = fit_file(dir.path(), &["on"], 16);
+    let on_bag = dir.path().join("fit-bag.toml");
+    let text = std::fs::read_to_string(&on_csv)
+        .unwrap()
+        .replace("recordings = [\"on\"]\n", "[[bags]]\npath = \"on/bag\"\nscenario = \"on/scenario.toml\"\n");
+    std::fs::write(&on_bag, text).unwrap();
+    let fitted: Vec<serde_json::Value> = [&on_csv, &on_bag]
+        .iter()
+        .enumerate()
+        .map(|(k, spec)| {
+            let out = dir.path().join(format!("fit{k}"));
+            let o = tendril(&["fit", spec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            fit_json(&out)
+        })
+        .collect();
+    for (key, _) in TRUTH {
+        let (a, b) = (best(&fitted[0], key), best(&fitted[1], key));
+        assert!((a - b).abs() <= 1e-3 * a.abs(), "{key}: {a} on the trace, {b} on the bag");
+    }
+    let objectives = fitted.iter().map(|f| f["objective"].as_f64().unwrap()).collect::<Vec<_>>();
+    assert!((objectives[0] - objectives[1]).abs() <= 1e-4, "{objectives:?}");
+}

@@ -8,6 +8,7 @@ mod common;
 mod python_clients;
 mod real_path;
 mod real_path_controllers;
+mod ros2;
 mod serve_run_e2e;
 mod virtual_dashboard;
 mod virtual_hyperion;

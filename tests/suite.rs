@@ -33,6 +33,7 @@ mod plot;
 mod protocol_props;
 mod render;
 mod results_durability;
+mod ros2_msgs_package;
 mod run_reproducible;
 mod scenario_keys;
 mod scene_export;

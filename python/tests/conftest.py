@@ -3,6 +3,7 @@
 import os
 import pathlib
 import shutil
+import socket
 
 import pytest
 
@@ -33,3 +34,21 @@ def tendril_bin():
 def without_timing(summary):
     """A summary without the fields that measure the machine."""
     return {k: v for k, v in summary.items() if k not in TIMING}
+
+
+def free_port_base():
+    """Seven consecutive free ports on loopback (serve's --port-base N takes N..N+6)."""
+    for base in range(43_000 + (os.getpid() % 500) * 12, 60_000, 12):
+        sockets = []
+        try:
+            for port in range(base, base + 7):
+                s = socket.socket()
+                sockets.append(s)
+                s.bind(("127.0.0.1", port))
+            return base
+        except OSError:
+            continue
+        finally:
+            for s in sockets:
+                s.close()
+    raise RuntimeError("no seven consecutive free ports")

@@ -2,7 +2,6 @@
 
 import os
 import queue
-import socket
 import subprocess
 import threading
 
@@ -10,26 +9,8 @@ import numpy as np
 import pytest
 
 import tendril
-from conftest import SHORT_LIFT
+from conftest import SHORT_LIFT, free_port_base
 from test_controller import PythonPid
-
-
-def _free_port_base():
-    """Seven consecutive free ports on loopback (serve's --port-base N takes N..N+6)."""
-    for base in range(43_000 + (os.getpid() % 500) * 12, 60_000, 12):
-        sockets = []
-        try:
-            for port in range(base, base + 7):
-                s = socket.socket()
-                sockets.append(s)
-                s.bind(("127.0.0.1", port))
-            return base
-        except OSError:
-            continue
-        finally:
-            for s in sockets:
-                s.close()
-    raise RuntimeError("no seven consecutive free ports")
 
 
 def _may_use_sched_fifo():
@@ -53,7 +34,7 @@ def _may_use_sched_fifo():
 def served(tendril_bin):
     """`tendril serve scenarios/short-lift.toml` on free ports: (port base, Dynamixel pty, rt priority)."""
     fifo = _may_use_sched_fifo()
-    base = _free_port_base()
+    base = free_port_base()
     args = [tendril_bin, "serve", str(SHORT_LIFT), "--port-base", str(base), "--seconds", "120"]
     if fifo:
         args += ["--rt-priority", "19"]

@@ -18,9 +18,9 @@ pub struct LatencyArgs {
     /// How long to measure [s].
     #[arg(long, default_value_t = 60.0)]
     seconds: f64,
-    /// Control rate [Hz].
-    #[arg(long, default_value_t = 500.0)]
-    rate_hz: f64,
+    /// Control rate [Hz] [default: 500; with --ros2 the scenario's `control_rate_hz`].
+    #[arg(long)]
+    rate_hz: Option<f64>,
     /// Ports of the virtual devices (N .. N+6 on 127.0.0.1).
     #[arg(long, default_value_t = 39400, value_parser = super::devices::port_base)]
     port_base: u16,
@@ -39,31 +39,39 @@ pub struct LatencyArgs {
     /// latency and missed deadlines the machine alone gives.
     #[arg(long)]
     floor: bool,
+    /// Measure the ROS 2 path instead (docs/cell/ros2.md): a topic's latency at the control rate,
+    /// the CPU share the twin's ROS 2 node adds to `tendril serve`, and a lock-step run's speed
+    /// against `tendril run`'s.
+    #[arg(long)]
+    ros2: bool,
 }
 
 pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(a.seconds > 0.0 && a.seconds <= 3600.0, "--seconds must be in (0, 3600], got {}", a.seconds);
+    let scenario: PickPlaceScenario = tendril_config::load(&a.scenario, &[])?;
+    let rate_hz = a.rate_hz.unwrap_or(if a.ros2 { scenario.control_rate_hz } else { 500.0 });
     // At least 1 Hz, and at least ten ticks in the measurement: at 0.001 Hz the first tick's wait
     // alone was 1000 s, and the command printed nothing for as long.
-    anyhow::ensure!(a.rate_hz >= 1.0 && a.rate_hz <= 2000.0, "--rate-hz must be in [1, 2000], got {}", a.rate_hz);
+    anyhow::ensure!((1.0..=2000.0).contains(&rate_hz), "--rate-hz must be in [1, 2000], got {rate_hz}");
     anyhow::ensure!(
-        a.rate_hz * a.seconds >= 10.0,
-        "--seconds {} at --rate-hz {} gives fewer than 10 ticks to measure",
-        a.seconds,
-        a.rate_hz
+        rate_hz * a.seconds >= 10.0,
+        "--seconds {} at --rate-hz {rate_hz} gives fewer than 10 ticks to measure",
+        a.seconds
     );
+    if a.ros2 {
+        return super::ros2_latency::run(&a.scenario, &scenario, rate_hz, a.seconds);
+    }
     anyhow::ensure!(
         a.stale_ms.is_finite() && (2.0..=10_000.0).contains(&a.stale_ms),
         "--stale-ms must be 2-10000 (one RTDE period to 10 s), got {}",
         a.stale_ms
     );
-    let scenario: PickPlaceScenario = tendril_config::load(&a.scenario, &[])?;
     let control = a.realtime.options()?;
-    let label = format!("{} Hz for {} s", a.rate_hz, a.seconds);
+    let label = format!("{rate_hz} Hz for {} s", a.seconds);
     let floor = if a.floor {
         // On a thread scheduled as the control thread will be, before the devices start.
         let idle =
-            std::thread::spawn(move || control.apply_to_current_thread().map(|()| measure_idle(a.rate_hz, a.seconds)));
+            std::thread::spawn(move || control.apply_to_current_thread().map(|()| measure_idle(rate_hz, a.seconds)));
         let r = idle.join().map_err(|_| anyhow::anyhow!("the empty-tick thread panicked"))??;
         emit(&format!("empty ticks (the machine alone), {label}: {}\n", describe(&r)));
         Some(r)
@@ -85,7 +93,7 @@ pub fn run(a: LatencyArgs) -> anyhow::Result<ExitCode> {
     // After the devices started, so that they do not inherit the control thread's CPU.
     control.apply_to_current_thread()?;
     let mut cell = RealCell::new(config);
-    let r = measure(&mut cell, a.rate_hz, a.seconds)?;
+    let r = measure(&mut cell, rate_hz, a.seconds)?;
     let motors = cell.motor_stats();
     drop(cell);
     serve.stop().map_err(|e| anyhow::anyhow!("twin: {e}"))?;

@@ -10,6 +10,7 @@ mod plot;
 mod realtime;
 mod render;
 mod reproduce;
+mod ros2_latency;
 mod run;
 mod scenario_args;
 mod sensor;

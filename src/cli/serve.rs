@@ -6,9 +6,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 use tendril_config::Override;
+use tendril_ros2::ClockMode;
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_serve::jitter::Link;
-use tendril_serve::{Jitter, JitterProfile, ProgramState, ServeConfig, start};
+use tendril_serve::{Jitter, JitterProfile, ProgramState, Ros2Serving, ServeConfig, start};
 
 /// Arguments of `tendril serve`.
 #[derive(Debug, clap::Args)]
@@ -48,6 +49,19 @@ pub struct ServeArgs {
     /// Inject the jitter into this link only (`rtde-out`, `rtde-in`, `peaks`, `bus`) [default: all].
     #[arg(long, value_enum)]
     jitter_link: Option<Link>,
+    /// Put the twin on the scenario's ROS 2 graph too (`[ros2]`: joint states, FBG peaks and
+    /// force estimates, `/clock`; commands on the joint command topic; docs/cell/ros2.md).
+    #[arg(long)]
+    ros2: bool,
+    /// With `--ros2`: lock step instead of real time (`[ros2] clock = "lockstep"`): the twin
+    /// advances one publish period per command, as fast as the commander goes; the device
+    /// protocols are not served then.
+    #[arg(long, requires = "ros2")]
+    lockstep: bool,
+    /// With `--ros2`: record the node's topics (what it publishes and the commands it receives)
+    /// into a rosbag2 bag (MCAP) in this folder, which must not exist.
+    #[arg(long, requires = "ros2")]
+    bag: Option<PathBuf>,
     #[command(flatten)]
     realtime: super::realtime::RealtimeArgs,
 }
@@ -63,8 +77,17 @@ fn port_base(text: &str) -> Result<u16, String> {
 
 pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
     let overlay = tendril_config::Overlay::load(a.overlay.as_deref())?;
-    let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &a.set)?;
+    let mut set = a.set.clone();
+    if a.lockstep {
+        set.push(Override { key: "ros2.clock".into(), value: toml::Value::String("lockstep".into()) });
+    }
+    let scenario: PickPlaceScenario = overlay.load_scenario(&a.scenario, &set)?;
+    let serving = a.ros2.then(|| Ros2Serving { bag: a.bag.clone() });
+    if let Some(serving) = serving.as_ref().filter(|_| scenario.ros2.clock == ClockMode::Lockstep) {
+        return serve_lockstep_cli(&scenario, serving, a.seconds);
+    }
     let mut config = ServeConfig::loopback();
+    config.ros2 = serving;
     config.bind = a.bind;
     config.realtime = a.realtime.options()?;
     if let Some(base) = a.port_base {
@@ -95,6 +118,9 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
             if p.fbg2().is_some() { ", its own FBG2" } else { ", pad 0's FBG2" },
             p.channel
         ));
+    }
+    if config.ros2.is_some() {
+        emit(&ros2_banner(&scenario));
     }
     if let Some(j) = config.jitter {
         let link = j.only.map_or("every link".to_string(), |l| format!("{l:?}"));
@@ -134,4 +160,53 @@ pub fn run(a: ServeArgs) -> anyhow::Result<ExitCode> {
         Ok(()) => Ok(ExitCode::SUCCESS),
         Err(e) => Err(anyhow::anyhow!("twin stopped: {e}")),
     }
+}
+
+/// What the twin's ROS 2 node publishes and takes, for the banner.
+fn ros2_banner(scenario: &PickPlaceScenario) -> String {
+    let r = &scenario.ros2;
+    let t = &r.topics;
+    format!(
+        "  ROS 2     domain {}, {:?}{}, node {}_twin, {} Hz {:?}\n            publishes {} {} {} {} {}\n            takes     {} (sensor_msgs/msg/JointState: {})\n",
+        r.domain_id,
+        r.distro,
+        if r.localhost_only { ", localhost only" } else { "" },
+        r.node_name,
+        r.publish_rate_hz,
+        r.clock,
+        r.resolve(&t.joint_states),
+        r.resolve(&t.clock),
+        r.resolve(&t.fbg_peaks),
+        (0..=scenario.array.pads.len()).map(|k| r.resolve(&t.fbg_wrench_of(k))).collect::<Vec<_>>().join(" "),
+        r.resolve(&t.tool_wrench),
+        r.resolve(&t.joint_commands),
+        r.joints.all().join(", ")
+    )
+}
+
+/// `tendril serve --ros2 --lockstep`: the twin on the graph alone, until Ctrl-C or `seconds`.
+fn serve_lockstep_cli(
+    scenario: &PickPlaceScenario,
+    serving: &Ros2Serving,
+    seconds: Option<f64>,
+) -> anyhow::Result<ExitCode> {
+    emit(&format!("tendril serve: {} (ROS 2 only, lock step)\n", scenario.name));
+    emit(&ros2_banner(scenario));
+    crate::signals::install_signal_handlers()?;
+    let started = std::time::Instant::now();
+    let stop = || {
+        tendril_cell::interrupt::requested().is_some() || seconds.is_some_and(|s| started.elapsed().as_secs_f64() >= s)
+    };
+    let report = tendril_serve::lockstep::serve_lockstep(scenario, serving, &stop, None)?;
+    emit(&format!(
+        "twin ran {:.2} s in {:.2} s wall ({} steps, {:.1}x real time)\n",
+        report.sim_s,
+        report.wall_s,
+        report.steps,
+        report.sim_s / report.wall_s.max(1e-9)
+    ));
+    if let Some(b) = report.bag {
+        emit(&format!("wrote {} ({} messages)\n", b.dir.display(), b.messages));
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -39,7 +39,7 @@ fn overrides_for(fit: &Fit, name: &str, values: &[f64]) -> Vec<Override> {
 /// One recording re-run with `values` and compared with it; `None` rows when the run could not
 /// start.
 pub fn replay(fit: &Fit, r: &Recording, values: &[f64]) -> (Residual, Option<RunReport>) {
-    match simulate(&r.table, &r.dir.join("summary.json"), &overrides_for(fit, &r.name, values)) {
+    match simulate(&r.table, &r.source, &overrides_for(fit, &r.name, values)) {
         Ok((summary, report)) => {
             let residual = compare(&r.name, &r.ticks, &r.events, &report.rows, &Events::of(&summary), &fit.weights);
             (residual, Some(report))
@@ -163,8 +163,8 @@ pub fn search_id(fit: &Fit) -> String {
         parts.push(toml::to_string(&t.table).unwrap_or_default().into_bytes());
     }
     for r in &fit.recordings {
-        parts.push(std::fs::read(r.dir.join("summary.json")).unwrap_or_default());
-        parts.push(format!("{:?}", r.ticks.len()).into_bytes());
+        parts.push(std::fs::read(&r.source).unwrap_or_default());
+        parts.push(format!("{:?}", r.ticks).into_bytes());
     }
     fnv(&parts)
 }

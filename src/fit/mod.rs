@@ -3,6 +3,7 @@
 //!
 //! - [`space`]: the parameters, their bounds and scales, checked against the scenarios.
 //! - [`recording`]: a run folder read back (trace and effective scenario) and checked.
+//! - [`bag`]: a rosbag2 recording (a lab's, or a run's `bag/`) read as a recording.
 //! - [`objective`]: the distance between a simulated run and a recording.
 //! - [`target`]: published figures (outcome, drop phase and time, rise, fluctuation) to match.
 //! - [`optimizer`]: the CMA-ES search, parallel, over the unit cube of the parameters.
@@ -11,6 +12,7 @@
 //! - [`execute`]: running a fit and writing its results.
 //! - [`tune`]: TUNE.toml and running a tune.
 
+pub mod bag;
 pub mod execute;
 pub mod log;
 pub mod objective;

@@ -61,8 +61,11 @@ impl Events {
 /// A recording read and checked.
 #[derive(Debug, Clone)]
 pub struct Recording {
-    /// The run directory.
+    /// The run directory (or the bag).
     pub dir: PathBuf,
+    /// The file its scenario came from (`summary.json`, or a bag's scenario file): what errors in
+    /// its scenario name.
+    pub source: PathBuf,
     /// A short name (the folder's name).
     pub name: String,
     /// The effective scenario, as a table that overrides apply to.
@@ -122,12 +125,26 @@ impl Recording {
         }
         let ticks = read_trace(&dir.join("trace.csv"), scenario.control_rate_hz)?;
         let name = dir.file_name().map_or_else(|| dir.display().to_string(), |n| n.to_string_lossy().to_string());
-        Ok(Recording { dir: dir.into(), name, table, scenario, ticks, events: Events::of(&summary) })
+        Ok(Recording {
+            dir: dir.into(),
+            source: summary_path,
+            name,
+            table,
+            scenario,
+            ticks,
+            events: Events::of(&summary),
+        })
     }
 }
 
 /// Reads the ticks of `trace.csv`, checking its columns and that its ticks are `1 / rate_hz` apart.
 fn read_trace(path: &Path, rate_hz: f64) -> Result<Vec<Tick>, RecordingError> {
+    let ticks = read_trace_columns(path)?;
+    check_ticks(path, ticks, rate_hz)
+}
+
+/// The ticks of `trace.csv`'s columns.
+fn read_trace_columns(path: &Path) -> Result<Vec<Tick>, RecordingError> {
     let err = |reason: String| RecordingError { file: path.into(), reason };
     let table = tendril_plot::input::Table::read(path).map_err(|e| err(e.to_string()))?;
     let mut cols = [0usize; 4];
@@ -154,6 +171,12 @@ fn read_trace(path: &Path, rate_hz: f64) -> Result<Vec<Tick>, RecordingError> {
         }
         ticks.push(Tick { time_s, phase: cells[cols[1]].clone(), force_n, twine_motor_rad });
     }
+    Ok(ticks)
+}
+
+/// `ticks` (read from `path`), checked: at least two, `1 / rate_hz` apart, time increasing.
+pub fn check_ticks(path: &Path, ticks: Vec<Tick>, rate_hz: f64) -> Result<Vec<Tick>, RecordingError> {
+    let err = |reason: String| RecordingError { file: path.into(), reason };
     if ticks.len() < 2 {
         return Err(err("fewer than two ticks: nothing to fit".into()));
     }

@@ -3,6 +3,9 @@
 //!
 //! ```toml
 //! recordings = ["runs/crimper-off", "runs/crimper-on"]   # run folders, relative to this file
+//! [[bags]]               # rosbag2 recordings (a lab's, or a run's bag/): fit::bag
+//! path = "../bags/crimper-on"
+//! scenario = "../crimper.toml"
 //! [[targets]]            # published figures instead of (or beside) recordings: fit::target
 //! scenario = "../crimper.toml"
 //! feedback = false
@@ -34,6 +37,7 @@
 //! recording's ([`super::objective`], in N) and each target seed's ([`super::target`], in
 //! tolerances). Everything is checked before anything runs ([`load_fit`]).
 
+use super::bag::{BagSpec, read_bag_recording};
 use super::objective::Weights;
 use super::optimizer::Budget;
 use super::recording::Recording;
@@ -51,6 +55,9 @@ pub struct FitFile {
     /// Run folders, relative to the fit file.
     #[serde(default)]
     pub recordings: Vec<PathBuf>,
+    /// rosbag2 recordings ([`super::bag`]), each with the scenario its cell ran.
+    #[serde(default)]
+    pub bags: Vec<BagSpec>,
     /// Published figures to match.
     #[serde(default)]
     pub targets: Vec<TargetSpec>,
@@ -97,6 +104,16 @@ pub enum SpecError {
         /// What is wrong with it.
         source: super::recording::RecordingError,
     },
+    /// A bag.
+    #[error("{file}: bags[{index}]: {source}")]
+    Bag {
+        /// The fit file.
+        file: PathBuf,
+        /// Position in `bags`.
+        index: usize,
+        /// What is wrong with it.
+        source: super::recording::RecordingError,
+    },
 }
 
 /// Reads a TOML spec file into `T`, errors naming the file and the dotted key.
@@ -123,10 +140,13 @@ pub fn invalid(file: &Path, (key, reason): (String, String)) -> ScenarioError {
 /// budget sane.
 pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
     let spec: FitFile = read_spec(file)?;
-    if spec.recordings.is_empty() && spec.targets.is_empty() {
+    if spec.recordings.is_empty() && spec.bags.is_empty() && spec.targets.is_empty() {
         return Err(invalid(
             file,
-            ("recordings".into(), "lists no recording, and there is no [[targets]] entry: nothing to fit".into()),
+            (
+                "recordings".into(),
+                "lists no recording, and there is no [[bags]] or [[targets]] entry: nothing to fit".into(),
+            ),
         )
         .into());
     }
@@ -138,7 +158,7 @@ pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
     }
     let params = super::space::parameters(file, &spec.parameters)?;
     let base = file.parent().unwrap_or(Path::new(""));
-    let recordings = spec
+    let mut recordings = spec
         .recordings
         .iter()
         .enumerate()
@@ -146,6 +166,11 @@ pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
             Recording::read(&base.join(dir)).map_err(|source| SpecError::Recording { file: file.into(), index, source })
         })
         .collect::<Result<Vec<_>, _>>()?;
+    for (index, bag) in spec.bags.iter().enumerate() {
+        let recording =
+            read_bag_recording(base, bag).map_err(|source| SpecError::Bag { file: file.into(), index, source })?;
+        recordings.push(recording);
+    }
     let targets = spec
         .targets
         .iter()
@@ -153,11 +178,9 @@ pub fn load_fit(file: &Path) -> Result<Fit, SpecError> {
         .map(|(index, t)| Target::load(file, base, index, t))
         .collect::<Result<Vec<_>, _>>()?;
     // Every run the fit makes: (name, where its scenario came from, the scenario).
-    let summaries: Vec<PathBuf> = recordings.iter().map(|r| r.dir.join("summary.json")).collect();
     let runs: Vec<(&str, &Path, &toml::Table)> = recordings
         .iter()
-        .zip(&summaries)
-        .map(|(r, f)| (r.name.as_str(), f.as_path(), &r.table))
+        .map(|r| (r.name.as_str(), r.source.as_path(), &r.table))
         .chain(targets.iter().map(|t| (t.name.as_str(), t.file.as_path(), &t.table)))
         .collect();
     if let Some(p) = params.iter().find(|p| p.scope().is_some_and(|s| !runs.iter().any(|r| r.0 == s))) {

@@ -60,8 +60,15 @@ pub fn markdown() -> Result<String, String> {
         for (key, rule) in at.rules() {
             rules.entry(key.clone()).or_default().insert(rule.clone());
         }
+        let mut value = serde_json::to_value(&scenario).map_err(|e| e.to_string())?;
+        // `[ros2]` is recorded only when it differs from its defaults (a run without it writes
+        // what it always wrote): its defaults are read from the section itself.
+        if let Some(fields) = value.as_object_mut() {
+            let ros2 = serde_json::to_value(&scenario.ros2).map_err(|e| e.to_string())?;
+            fields.entry("ros2").or_insert(ros2);
+        }
         let mut flat = Vec::new();
-        flatten("", &serde_json::to_value(&scenario).map_err(|e| e.to_string())?, &mut flat);
+        flatten("", &value, &mut flat);
         instances.push(Instance { values: flat.into_iter().collect(), rules });
     }
     let mut rows = Vec::new();

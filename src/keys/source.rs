@@ -27,6 +27,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("crates/twin/src/physics/config.rs", include_str!("../../crates/twin/src/physics/config.rs")),
     ("crates/drivers/src/config.rs", include_str!("../../crates/drivers/src/config.rs")),
     ("crates/hyperion/src/fbg_map.rs", include_str!("../../crates/hyperion/src/fbg_map.rs")),
+    ("crates/ros2/src/config.rs", include_str!("../../crates/ros2/src/config.rs")),
 ];
 
 /// One field of a struct.

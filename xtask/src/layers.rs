@@ -19,12 +19,12 @@ pub const LAYERS: &[&[&str]] = &[
     // Leaves: configuration, the arm's geometry, the protocols' shared framing.
     &["tendril-codec", "tendril-config", "tendril-ur5e"],
     // The sensor model and the sans-IO protocols.
-    &["tendril-fbg", "tendril-rtde", "tendril-dynamixel"],
+    &["tendril-fbg", "tendril-rtde", "tendril-dynamixel", "tendril-ros2msg"],
     &["tendril-hyperion", "tendril-urscript"],
     // The seam.
     &["tendril-cell"],
     // Above the seam: the control side, the twin, the real devices' drivers.
-    &["tendril-control", "tendril-twin", "tendril-drivers"],
+    &["tendril-control", "tendril-twin", "tendril-drivers", "tendril-ros2"],
     // One run on any cell; pictures of the twin's scene.
     &["tendril-run", "tendril-render"],
     // The virtual devices, the charts.
@@ -41,6 +41,7 @@ pub const LIGHT: &[&str] = &[
     "tendril-fbg",
     "tendril-rtde",
     "tendril-dynamixel",
+    "tendril-ros2msg",
     "tendril-hyperion",
     "tendril-urscript",
     "tendril-cell",

@@ -197,10 +197,20 @@ fn python_package_tests(python: &Path) -> Result<(), String> {
 
 /// Independent protocol clients the tests run against the virtual devices (tests/python_clients.rs),
 /// pinned: SDU `ur_rtde` (a cp311 manylinux wheel, so the venv needs Python 3.11) and ROBOTIS
-/// `dynamixel-sdk` with its one dependency; and MuJoCo's own Python package, which opens the scene
-/// `tendril scene` exports (tests/scene_export.rs). Installed once into `vendor/venv`; returns its
-/// python.
-const PYTHON_CLIENTS: [&str; 4] = ["ur_rtde==1.6.5", "dynamixel-sdk==4.1.0", "pyserial==3.5", "mujoco==3.17.0"];
+/// `dynamixel-sdk` with its one dependency; MuJoCo's own Python package, which opens the scene
+/// `tendril scene` exports (tests/scene_export.rs); and the ROS 2 peers of python/tests/test_ros2.py,
+/// none of which needs a ROS installation: Eclipse Cyclone DDS (the DDS behind `rmw_cyclonedds`,
+/// its C library in the wheel) as the lab's node, `rosbags` reading bags (sqlite3 and MCAP), and
+/// Foxglove's `mcap` reader. Installed once into `vendor/venv`; returns its python.
+const PYTHON_CLIENTS: [&str; 7] = [
+    "ur_rtde==1.6.5",
+    "dynamixel-sdk==4.1.0",
+    "pyserial==3.5",
+    "mujoco==3.17.0",
+    "cyclonedds==11.0.1",
+    "rosbags==0.11.9",
+    "mcap==1.6.0",
+];
 
 fn python_clients() -> Result<PathBuf, String> {
     let venv = workspace_root().join("vendor/venv");

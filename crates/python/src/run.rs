@@ -100,7 +100,7 @@ pub fn run<'py>(
             let slow = timing_ref.as_ref().filter(|_| real).and_then(|t| t.get().too_slow());
             slow.map(|cause| CellError::Device { device: "python controller".into(), cause })
         };
-        let driver = Driver { controller: controller.map(|c| Box::new(c) as _), check: Some(&mut check) };
+        let driver = Driver { controller: controller.map(|c| Box::new(c) as _), check: Some(&mut check), bag: false };
         match cell {
             Target::Twin => run_on_twin_with(scenario_ref, &ModelCache::default(), out, driver),
             Target::Real(config) => {
@@ -219,7 +219,7 @@ pub fn run_many<'py>(
                             flag.load(Ordering::SeqCst)
                                 .then(|| CellError::Device { device: "python".into(), cause: INTERRUPTED.into() })
                         };
-                        let driver = Driver { controller: None, check: Some(&mut check) };
+                        let driver = Driver { controller: None, check: Some(&mut check), bag: false };
                         let r = (!flag.load(Ordering::SeqCst)).then(|| run_on_twin_with(s, models, None, driver));
                         let _ = ended.send(());
                         r

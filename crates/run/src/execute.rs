@@ -1,6 +1,7 @@
 //! One scenario, start to finish, on the twin: build (or reuse) the scene model, run the task,
 //! write `trace.csv`, `summary.json` and `frames.bin`.
 
+use super::bag::RunBag;
 use super::runner::RunReport;
 use super::scenario::PickPlaceScenario;
 use super::session::{Action, Session};
@@ -22,6 +23,9 @@ pub struct Driver<'a> {
     /// deactivated, the outcome `error`): how a controller that cannot fail through
     /// [`ForceController::update`] reports that it did.
     pub check: Option<&'a mut (dyn FnMut() -> Option<CellError> + Send)>,
+    /// Also record the run as a rosbag2 bag in its directory's `bag/` (`--bag`; refused when one
+    /// is there already).
+    pub bag: bool,
 }
 
 /// Compiled scene models, shared between runs whose scenes are identical (a gain sweep
@@ -105,9 +109,17 @@ pub fn run_on_cell_with(
     started: super::clock::RunClock,
     driver: Driver<'_>,
 ) -> anyhow::Result<(RunSummary, RunReport)> {
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+    }
+    // The bag first: a bag already there refuses the run before any file is written over.
+    let bag = match (driver.bag, out) {
+        (true, Some(dir)) => Some(RunBag::create(dir, &scenario.ros2, &scenario.array)?),
+        (true, None) => anyhow::bail!("a bag is written into the run's directory: give the run one"),
+        (false, _) => None,
+    };
     let trace = match out {
         Some(dir) => {
-            std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
             // Frames of an earlier run in this folder are not this run's (a run on the real cell
             // records none; a twin run writes its own after the run).
             let _ = std::fs::remove_file(dir.join(tendril_twin::frames::FRAMES_FILE));
@@ -117,9 +129,12 @@ pub fn run_on_cell_with(
         None => None,
     };
     let plan = scenario.control_plan();
-    let Driver { controller, mut check } = driver;
+    let Driver { controller, mut check, .. } = driver;
     let controller = controller.unwrap_or_else(|| plan.controller.build());
     let mut session = Session::start(&mut *cell, &plan, controller, trace);
+    if let Some(bag) = bag {
+        session.record_bag(bag);
+    }
     match check.as_mut() {
         None => session.run_to_end(),
         Some(check) => {

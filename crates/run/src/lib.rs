@@ -4,6 +4,7 @@
 mod array_estimates;
 pub mod array_summary;
 mod backend_defaults;
+pub mod bag;
 pub mod clock;
 pub mod compare;
 pub mod drop_watch;
@@ -14,6 +15,7 @@ mod paths;
 pub mod plan;
 pub mod real;
 pub mod report;
+pub mod ros2;
 pub mod runner;
 mod samples;
 pub mod scenario;

@@ -20,6 +20,7 @@ use tendril_drivers::HardwareConfig;
 use tendril_fbg::array::ArrayConfig;
 use tendril_fbg::estimate::ForceCalibration;
 use tendril_fbg::{InterrogatorConfig, SensorConfig};
+use tendril_ros2::Ros2Config;
 use tendril_twin::disturbance::DisturbanceConfig;
 use tendril_twin::physics::{FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, SceneModel, SceneSpec};
 use tendril_twin::sim::{EnvironmentConfig, SimCell};
@@ -94,6 +95,10 @@ pub struct PickPlaceScenario {
     /// Disturbances on the twin (a push on the object, a sensor dropout); none by default.
     #[serde(default)]
     pub disturbance: DisturbanceConfig,
+    /// How tendril meets a lab's ROS 2 graph: `tendril serve --ros2`, `--hardware ros2` and
+    /// `--bag` (docs/cell/ros2.md); the defaults are a Humble lab's.
+    #[serde(default, skip_serializing_if = "Ros2Config::is_default")]
+    pub ros2: Ros2Config,
 }
 
 fn default_seed() -> u64 {
@@ -134,6 +139,7 @@ impl Validate for PickPlaceScenario {
         at.section("finger", &self.finger);
         at.section("hardware", &self.hardware);
         at.section("disturbance", &self.disturbance);
+        at.section("ros2", &self.ros2);
         at.require(
             "disturbance.push",
             self.disturbance.push.is_none() || self.physics.backend == tendril_twin::physics::Backend::Mujoco,

@@ -17,6 +17,7 @@
 //! place for the tick.
 
 use super::array_estimates::ArrayEstimates;
+use super::bag::RunBag;
 use super::drop_watch::DropWatch;
 use super::metrics::control_metrics;
 use super::plan::ControlPlan;
@@ -107,6 +108,8 @@ pub struct Session<C: Cell> {
     tick: u64,
     rows: Vec<TraceRow>,
     trace: Option<TraceWriter>,
+    /// The run's bag, when it records one ([`Session::record_bag`]).
+    bag: Option<RunBag>,
     /// The reading the next step acts on.
     pending: Option<Pending>,
     /// Why the run ended early, if it did.
@@ -150,6 +153,7 @@ impl<C: Cell> Session<C> {
             tick: 0,
             rows: Vec::new(),
             trace,
+            bag: None,
             pending: None,
             over: error.is_some(),
             error,
@@ -159,6 +163,12 @@ impl<C: Cell> Session<C> {
             session.sense();
         }
         session
+    }
+
+    /// Records every tick from now on into `bag` too (a run's `bag/`), ended by
+    /// [`Session::finish`] whatever happens.
+    pub fn record_bag(&mut self, bag: RunBag) {
+        self.bag = Some(bag);
     }
 
     /// What the caller sees now: the latest reading, not yet acted on (`None` once the run is over).
@@ -382,6 +392,10 @@ impl<C: Cell> Session<C> {
         if let Some(w) = self.trace.as_mut() {
             w.write(&row).map_err(|e| CellError::Device { device: "trace".into(), cause: e.to_string() })?;
         }
+        if let Some(b) = self.bag.as_mut() {
+            b.record(&state, &decision.command, &row)
+                .map_err(|e| CellError::Device { device: "bag".into(), cause: e.to_string() })?;
+        }
         self.rows.push(row);
         Ok(row)
     }
@@ -417,7 +431,9 @@ impl<C: Cell> Session<C> {
             // write errors.
             let _ = w.flush();
         }
-        let error = self.error.take().or(stop.err()).map(|e| e.to_string());
+        // The bag is ended whatever happened: the ticks recorded stay readable.
+        let bag = self.bag.take().map(RunBag::finish).and_then(Result::err);
+        let error = self.error.take().or(stop.err()).map(|e| e.to_string()).or(bag.map(|e| format!("bag: {e}")));
         let rows = std::mem::take(&mut self.rows);
         let slip = &self.slip;
         let sensor_drop = slip.events().dropped_s.map(|t| Drop { cell_time_s: t, phase: phase_at(&rows, t) });

@@ -3,6 +3,7 @@
 
 use super::controller::VirtualUrSetup;
 use super::jitter::Jitter;
+use super::ros2::Ros2Serving;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::time::Duration;
 use tendril_drivers::realtime::RealtimeOptions;
@@ -44,6 +45,8 @@ pub struct ServeConfig {
     /// Timing faults injected into the RTDE streams (both ways), the peak stream and the Dynamixel
     /// bus ([`crate::jitter`]; default none).
     pub jitter: Option<Jitter>,
+    /// Put the twin on the scenario's ROS 2 graph too (`--ros2`, [`crate::ros2`]; default off).
+    pub ros2: Option<Ros2Serving>,
 }
 
 /// How long an RTDE or HYPERION command connection may stay silent both ways before the virtual
@@ -71,6 +74,7 @@ impl ServeConfig {
             realtime: RealtimeOptions::default(),
             idle_timeout: IDLE_TIMEOUT,
             jitter: None,
+            ros2: None,
         }
     }
 

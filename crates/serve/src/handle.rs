@@ -97,7 +97,7 @@ pub fn start(scenario: &PickPlaceScenario, config: &ServeConfig) -> anyhow::Resu
     let epoch = std::time::Instant::now();
     let (addrs, ur_addrs) = runtime.block_on(net::listen_all(config, state.clone(), ticks.subscribe(), epoch))?;
     let (pty_path, bus) = bus::open_bus(state.clone(), stop.clone(), rt, config.jitter, epoch)?;
-    let twin = twin::spawn(scenario.clone(), config.period_s, state.clone(), ticks, stop.clone(), rt, config.jitter)?;
+    let twin = twin::spawn(scenario.clone(), config, state.clone(), ticks, stop.clone())?;
     Ok(ServeHandle {
         pty_path,
         addrs,

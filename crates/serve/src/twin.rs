@@ -1,18 +1,20 @@
 //! The twin thread: the SimCell stepped in real time, its state put into the devices each tick.
 
-use super::jitter::{DelayLine, Jitter, Link};
+use super::config::ServeConfig;
+use super::jitter::{DelayLine, Link};
 use super::program::{ArmCommand, ProgramRunner};
+use super::ros2::Ros2Bridge;
 use super::setpoint::{ArmPath, servo_delay_s};
 use super::state::{DeviceState, ProgramState, TwinStatus, lock};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tendril_cell::{ARM_JOINTS, Cell, CellCommand};
-use tendril_drivers::realtime::RealtimeOptions;
 use tendril_dynamixel::ControlTable;
 use tendril_dynamixel::control_table::addr;
 use tendril_dynamixel::units::{present_current_units, present_velocity_units, rad_to_ticks, ticks_to_rad};
 use tendril_hyperion::{PeakFrame, PeakHeader};
+use tendril_ros2::state::CellSample;
 use tendril_rtde::state::{
     RUNTIME_STATE_PAUSED, RUNTIME_STATE_PLAYING, RUNTIME_STATE_STOPPED, SAFETY_MODE_NORMAL, SAFETY_MODE_PROTECTIVE_STOP,
 };
@@ -60,17 +62,17 @@ fn rtde_sample(before: (f64, [f64; 6]), after: (f64, [f64; 6]), t: f64) -> (f64,
     (t, std::array::from_fn(|j| before.1[j] + (after.1[j] - before.1[j]) * f))
 }
 
-/// Runs the twin in real time on its own thread (the MuJoCo data stays on it); `jitter`, if it
-/// names [`Link::Twin`], stalls that thread.
+/// Runs the twin in real time on its own thread (the MuJoCo data stays on it), ticking every
+/// `config.period_s` with `config.realtime`'s scheduling; `config.jitter`, if it names
+/// [`Link::Twin`], stalls that thread; `config.ros2` puts its ROS 2 node on it.
 pub fn spawn(
     scenario: PickPlaceScenario,
-    period_s: f64,
+    config: &ServeConfig,
     state: Arc<Mutex<DeviceState>>,
     ticks: tokio::sync::watch::Sender<u64>,
     stop: Arc<AtomicBool>,
-    realtime: RealtimeOptions,
-    jitter: Option<Jitter>,
 ) -> anyhow::Result<std::thread::JoinHandle<Result<(), String>>> {
+    let (period_s, realtime, jitter, ros2) = (config.period_s, config.realtime, config.jitter, config.ros2.clone());
     let model = SceneModel::build(&scenario.scene_spec())?;
     let motors = scenario.hardware.motor_ids();
     // Where each pad's gratings are: every peak of the layout is served on its channel.
@@ -114,6 +116,12 @@ pub fn spawn(
         let mut path: Option<ArmPath> = None;
         let timestep_s = scenario.physics.timestep_s;
         let servo_delay_s = servo_delay_s(period_s, timestep_s);
+        // The twin's ROS 2 node (`--ros2`): commands taken and state published on this thread.
+        let mut ros = match &ros2 {
+            Some(r) => Some(Ros2Bridge::new(&scenario, r.bag.as_deref()).map_err(|e| format!("ROS 2: {e:#}"))?),
+            None => None,
+        };
+        let publish_every = ros.as_ref().map_or(1, |r| ((r.publish_period_s() / period_s).round() as u64).max(1));
         {
             let mut s = lock(&state);
             for (id, rad) in motors.into_iter().zip([first.growth_motor_rad, first.twine_motor_rad]) {
@@ -141,9 +149,13 @@ pub fn spawn(
             jitter.filter(|j| j.applies_to(Link::Twin)).map(|j| DelayLine::new(j.model, j.seed, Link::Twin));
         for k in 1u64.. {
             if stop.load(Ordering::SeqCst) {
+                if let Some(bridge) = ros {
+                    bridge.finish().map_err(|e| format!("ROS 2 bag: {e:#}"))?;
+                }
                 return Ok(());
             }
             let now_s = (k - 1) as f64 * period_s;
+            let ros_commands = ros.as_mut().map(|r| r.take_commands(now_s)).unwrap_or_default();
             let new_arm_target = {
                 let mut s = lock(&state);
                 // RTDEIOInterface and the like: the IO outputs each input package set.
@@ -167,6 +179,18 @@ pub fn spawn(
                         true
                     }
                 };
+                // A ROS 2 arm command is a `servoj` target, due at its stamp on the twin's clock: the
+                // setpoint passes it the commander's period and a servo delay later.
+                for (q, due_s, lag_s) in
+                    ros.as_mut().map(|r| r.arm_targets(&ros_commands, &mut s, now_s, measured_q)).unwrap_or_default()
+                {
+                    let last = (command.arm_q, last_step.0);
+                    path = Some(ArmPath::servo(path.take(), q, due_s, servo_delay_s + lag_s, last));
+                }
+                // ROS 2 motor commands set the MX-106s' Goal Position, as a bus write would.
+                if let Some(r) = ros.as_mut() {
+                    super::ros2::drive_motors(r, &ros_commands, &mut s, motors, now_s, period_s);
+                }
                 // The physics steps in this tick's wait: command the trajectory's setpoint at the
                 // step's end (a step is due once the wait passes half of it, as `wait_until` runs).
                 let physics_s = last_step.0;
@@ -279,6 +303,23 @@ pub fn spawn(
                     truth,
                     ticks: k,
                 };
+            }
+            if let Some(bridge) = ros.as_mut()
+                && k % publish_every == 0
+            {
+                let sample = CellSample {
+                    time_s: sample_s,
+                    arm_q: sample_q,
+                    arm_qd: Some(actual_qd),
+                    motors_rad,
+                    motors_rad_s: Some(motor_rad_s),
+                    motors_nm: Some(motor_torque_nm),
+                    wavelengths: r.wavelengths,
+                    array: r.array,
+                    pad_force_n: Vec::new(),
+                    tool_load_n: r.tool_load_n,
+                };
+                bridge.publish(sample).map_err(|e| format!("ROS 2: {e:#}"))?;
             }
             ticks.send_replace(k);
             let due_s = k as f64 * period_s;
