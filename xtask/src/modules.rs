@@ -6,8 +6,11 @@
 //! written inline, outside comments and outside `#[cfg(test)]` modules) starts at `crate::`,
 //! `super::` or `self::` and names that module, or an item in it. A *face* (a file that only
 //! declares modules and hands names on with `pub use`, as a `mod.rs` or `lib.rs` may) is no
-//! room of its own: imports through it count as imports of nothing, so children may use their
-//! parent's re-exports without a loop.
+//! room of its own: a path through it is followed to the module its `pub use` names, so
+//! `crate::physics::Physics` imports `physics/engine.rs` when `physics/mod.rs` says
+//! `pub use engine::Physics`, and a child using its parent's re-export of the child's own item
+//! ties nothing. A name a face does not re-export by name (a glob, another crate's item) ties
+//! nothing.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -53,15 +56,19 @@ pub fn graph(files: &[(PathBuf, String)]) -> Graph {
         })
         .collect();
     let by_path: BTreeMap<&[String], &Module> = modules.iter().map(|m| (m.path.as_slice(), m)).collect();
+    let faces: BTreeMap<&[String], Vec<(String, String)>> = modules
+        .iter()
+        .filter(|m| m.face)
+        .filter_map(|m| files.iter().find(|(f, _)| f == &m.file).map(|(_, text)| (m.path.as_slice(), re_exports(text))))
+        .collect();
     let mut edges: BTreeMap<(PathBuf, PathBuf), BTreeSet<String>> = BTreeMap::new();
     for (file, text) in files {
         let Some(me) = modules.iter().find(|m| &m.file == file) else { continue };
         if me.face {
             continue;
         }
-        let dir_of_children = children_parent(&me.path, file);
         for written in paths(&strip(text)) {
-            let Some((target, rest)) = resolve(&written, &me.path, &dir_of_children, &by_path) else { continue };
+            let Some((target, rest)) = resolve_through_faces(&written, &me.path, &by_path, &faces) else { continue };
             if target.file == me.file || target.face {
                 continue;
             }
@@ -183,11 +190,6 @@ fn module_path(file: &Path) -> Option<Vec<String>> {
     Some(parts)
 }
 
-/// The module whose children a file's `mod x;` declares: the file's own module.
-fn children_parent(path: &[String], _file: &Path) -> Vec<String> {
-    path.to_vec()
-}
-
 /// Whether a file only declares modules and re-exports (and holds docs and attributes).
 fn is_face(text: &str) -> bool {
     // Inside a `pub use a::{...};` that spans lines, until its `;`.
@@ -281,7 +283,9 @@ fn paths(code: &str) -> Vec<String> {
             continue;
         }
         let end = code[start..].find(';').map_or(code.len(), |e| start + e);
-        expand(code[start + 4..end].trim(), "", &mut out);
+        let mut named = Vec::new();
+        expand(code[start + 4..end].trim(), "", &mut named);
+        out.extend(named.into_iter().map(|(_, path)| path));
         i = end;
     }
     rest.push_str(&code[i..]);
@@ -304,8 +308,25 @@ fn paths(code: &str) -> Vec<String> {
     out
 }
 
-/// Expands one `use` tree below `prefix`.
-fn expand(tree: &str, prefix: &str, out: &mut Vec<String>) {
+/// The names a file hands on with `pub use` (or `pub(crate) use`), each with the path it names
+/// as written (`pub use engine::Physics as Engine;` gives (`Engine`, `engine::Physics`)).
+fn re_exports(text: &str) -> Vec<(String, String)> {
+    let code = strip(text);
+    let mut out = Vec::new();
+    for opener in ["pub use ", "pub(crate) use "] {
+        let mut from = 0;
+        while let Some(at) = code[from..].find(opener) {
+            let start = from + at + opener.len();
+            let end = code[start..].find(';').map_or(code.len(), |e| start + e);
+            expand(code[start..end].trim(), "", &mut out);
+            from = end;
+        }
+    }
+    out
+}
+
+/// Expands one `use` tree below `prefix` into (the name it brings in, the path it names).
+fn expand(tree: &str, prefix: &str, out: &mut Vec<(String, String)>) {
     let tree = tree.trim();
     if let Some(open) = tree.find('{') {
         let head = tree[..open].trim().trim_end_matches("::");
@@ -328,12 +349,11 @@ fn expand(tree: &str, prefix: &str, out: &mut Vec<String>) {
         }
         expand(&part, &prefix, out);
     } else if !tree.is_empty() {
-        let tree = tree.split(" as ").next().unwrap_or(tree).trim();
-        if tree != "self" {
-            out.push(join(prefix, tree));
-        } else {
-            out.push(prefix.to_string());
-        }
+        let mut parts = tree.split(" as ");
+        let tree = parts.next().unwrap_or(tree).trim();
+        let path = if tree != "self" { join(prefix, tree) } else { prefix.to_string() };
+        let name = parts.next().map(str::trim).unwrap_or_else(|| path.rsplit("::").next().unwrap_or(&path));
+        out.push((name.to_string(), path));
     }
 }
 
@@ -345,12 +365,42 @@ fn join(prefix: &str, tail: &str) -> String {
     }
 }
 
+/// [`resolve`], then through each face the path lands on to the module the face's `pub use`
+/// names; `None` when the path ends at a face (the module itself, or a name it does not
+/// re-export by name).
+fn resolve_through_faces<'a>(
+    written: &str,
+    me: &[String],
+    by_path: &BTreeMap<&[String], &'a Module>,
+    faces: &BTreeMap<&[String], Vec<(String, String)>>,
+) -> Option<(&'a Module, String)> {
+    let mut written = written.to_string();
+    let mut from = me.to_vec();
+    // Faces re-exporting each other in a ring would never end: a crate is never this deep.
+    for _ in 0..16 {
+        let (target, rest) = resolve(&written, &from, by_path)?;
+        if !target.face {
+            return Some((target, rest));
+        }
+        let (first, tail) = rest.split_once("::").unwrap_or((rest.as_str(), ""));
+        let (_, path) = faces.get(target.path.as_slice())?.iter().find(|(name, _)| name == first)?;
+        let rooted = ["crate", "self", "super"].iter().any(|r| path == r || path.starts_with(&format!("{r}::")));
+        written = match (rooted, tail.is_empty()) {
+            (true, true) => path.clone(),
+            (true, false) => format!("{path}::{tail}"),
+            (false, true) => format!("self::{path}"),
+            (false, false) => format!("self::{path}::{tail}"),
+        };
+        from = target.path.clone();
+    }
+    None
+}
+
 /// The module a path written in module `me` names (the longest module prefix), and the rest of
 /// the path after it.
 fn resolve<'a>(
     written: &str,
     me: &[String],
-    _children: &[String],
     by_path: &BTreeMap<&[String], &'a Module>,
 ) -> Option<(&'a Module, String)> {
     let mut segs: Vec<&str> = written.split("::").filter(|s| !s.is_empty()).collect();
@@ -419,6 +469,26 @@ mod tests {
         ]));
         assert!(loops(&g).is_empty(), "{:?}", g.edges);
         assert_eq!(g.edges.len(), 2, "x -> scene and y -> x: {:?}", g.edges);
+    }
+
+    #[test]
+    fn an_inline_path_loop_through_a_face_is_found() {
+        // The shape of a loop once left in tendril-twin: `frames` names the trait through the
+        // `physics` face, `physics/engine.rs` names the snapshot in `frames`, both inline.
+        let g = graph(&tree(&[
+            ("lib.rs", "pub mod frames;\npub mod physics;\n"),
+            ("physics/mod.rs", "mod engine;\npub use engine::Physics as Engine;\npub use engine::{Other};\n"),
+            ("physics/engine.rs", "pub trait Physics { fn s(&self) -> Option<crate::frames::Snapshot>; }\n"),
+            ("frames.rs", "pub struct Snapshot;\npub fn offer(p: &dyn crate::physics::Engine) {}\n"),
+        ]));
+        let loops = loops(&g);
+        assert_eq!(loops.len(), 1, "{:?}", g.edges);
+        let text: Vec<String> =
+            loops[0].iter().map(|e| format!("{} -> {}: {:?}", e.from.display(), e.to.display(), e.names)).collect();
+        assert_eq!(
+            text,
+            ["frames.rs -> physics/engine.rs: {\"Physics\"}", "physics/engine.rs -> frames.rs: {\"Snapshot\"}"]
+        );
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! [`RtdeError`]: why bytes are not a valid frame or packet.
 
-use super::types::RtdeType;
+use super::data_type::RtdeType;
 
 /// RTDE protocol errors.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

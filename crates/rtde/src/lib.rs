@@ -3,6 +3,7 @@
 
 pub mod client;
 pub mod dashboard;
+mod data_type;
 mod error;
 pub mod fields;
 pub mod packet;

@@ -19,19 +19,8 @@
 
 use std::path::Path;
 
-/// One state of the scene in MuJoCo's layout (the compiled [`crate::physics::SceneModel`]'s `qpos`,
-/// `qvel`, `ctrl`, `act`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Snapshot {
-    /// Generalised positions.
-    pub qpos: Vec<f64>,
-    /// Generalised velocities.
-    pub qvel: Vec<f64>,
-    /// Actuator controls.
-    pub ctrl: Vec<f64>,
-    /// Actuator activations.
-    pub act: Vec<f64>,
-}
+// The state is the physics's (a run hands it out); the frames file records it.
+pub use crate::physics::Snapshot;
 
 /// The file's name in a run directory.
 pub const FRAMES_FILE: &str = "frames.bin";

@@ -2,7 +2,7 @@
 
 use super::config::Backend;
 use super::error::PhysicsError;
-use super::scene::PhysicsReadout;
+use super::readout::{PhysicsReadout, Snapshot};
 
 /// One simulation run of the cell, whichever engine steps it. The cell ([`crate::sim`]) only
 /// talks to this.
@@ -44,7 +44,7 @@ pub trait Physics: Send {
 
     /// The whole scene's state in MuJoCo's layout (qpos, qvel, ctrl, act of the compiled
     /// [`super::SceneModel`]), recorded for `tendril render`; `None` when the backend has no such state.
-    fn snapshot(&self) -> Option<crate::frames::Snapshot> {
+    fn snapshot(&self) -> Option<Snapshot> {
         None
     }
 

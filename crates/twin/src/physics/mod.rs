@@ -13,8 +13,9 @@
 //!   strip; [`census`]: contacts per geom pair over a run (what the collision search finds).
 //! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
 //! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
-//! - `spec.rs`: what a scene holds ([`SceneSpec`]); `engine.rs`: the [`Physics`] trait; `start.rs`: a run
-//!   on a model ([`SceneModel::start`]).
+//! - `spec.rs`: what a scene holds ([`SceneSpec`]); `engine.rs`: the [`Physics`] trait; `readout.rs`:
+//!   what a run hands out ([`PhysicsReadout`], [`Snapshot`]); `start.rs`: a run on a model
+//!   ([`SceneModel::start`]).
 
 pub mod census;
 pub mod check;
@@ -27,6 +28,7 @@ pub mod export;
 pub mod guide;
 pub mod object;
 pub mod rapier;
+mod readout;
 pub mod scene;
 mod spec;
 mod start;
@@ -41,5 +43,6 @@ pub use config::{
 };
 pub use engine::Physics;
 pub use error::{Divergence, PhysicsError};
-pub use scene::{PhysicsReadout, Scene, SceneModel};
+pub use readout::{PhysicsReadout, Snapshot};
+pub use scene::{Scene, SceneModel};
 pub use spec::{PadPlace, SceneSpec};

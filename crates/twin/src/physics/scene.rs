@@ -5,7 +5,7 @@ use super::compose::{self, Placement};
 use super::config::{ArmMode, Backend};
 use super::drive::{Drive, grip_in_hand};
 use super::guide::GuidePruning;
-use super::{Divergence, PadPlace, Physics, PhysicsError, SceneSpec};
+use super::{Divergence, PadPlace, Physics, PhysicsError, PhysicsReadout, SceneSpec, Snapshot};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtEnableBit, mjtState, mjtWarning};
 use mujoco_rs::prelude::{MjData, MjModel};
 use nalgebra::{Isometry3, Vector3};
@@ -133,7 +133,7 @@ impl SceneModel {
             Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids, guide_pruning });
         if spec.physics.backend == Backend::Rapier {
             // Translate once now, so an element rapier cannot take is an error before any run starts.
-            super::rapier::RapierScene::new(shared.clone())?;
+            super::rapier::RapierWorld::build(&shared.model, &spec.physics, &shared.ids.arm_joint)?;
         }
         Ok(shared)
     }
@@ -274,58 +274,6 @@ impl SceneModel {
     pub fn xml(&self) -> &str {
         &self.xml
     }
-}
-
-/// What the physics reports after a step (SI units, world frame).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct PhysicsReadout {
-    /// Simulated time \[s\].
-    pub time_s: f64,
-    /// Normal force of the object on the sensor pad (casing and bump) \[N\]: the FBG sensor's input.
-    pub pad_force_n: f64,
-    /// Normal force of the object on each further pad of a sensor array \[N\] (empty without one).
-    pub extra_pad_forces_n: PerPad<f64>,
-    /// Sum of the normal forces between the object and the whole finger, pad included \[N\].
-    pub grip_force_n: f64,
-    /// Normal force between the object and the palm beside the guide exit \[N\] (not part of the grip
-    /// force: the palm is the hand, not the finger).
-    pub palm_force_n: f64,
-    /// Number of active object-finger contacts.
-    pub grip_contacts: usize,
-    /// Whether the object touches the finger at all.
-    pub touching: bool,
-    /// Object body origin (footprint centre) \[m\].
-    pub object_pos_m: [f64; 3],
-    /// Object orientation (w, x, y, z).
-    pub object_quat: [f64; 4],
-    /// Linear velocity of the object's grip centre (the middle of the wrapped handle or neck) [m/s].
-    pub object_vel_m_s: [f64; 3],
-    /// The object's grip centre expressed in the hand frame \[m\]: its change is the slip distance (hand z
-    /// points down in the pick pose, so a falling object's z grows).
-    pub object_in_hand_m: [f64; 3],
-    /// Speed of the object's grip centre relative to the hand point it coincides with [m/s].
-    pub slip_speed_m_s: f64,
-    /// Hand (flange) position \[m\].
-    pub hand_pos_m: [f64; 3],
-    /// Finger growth out of the guide \[m\] (actual motor position).
-    pub growth_m: f64,
-    /// Tendon wound in by the twine motor \[m\] (actual motor position).
-    pub twine_m: f64,
-    /// The twine servo's current setpoint \[m\] (the command after the motor speed limit).
-    pub twine_setpoint_m: f64,
-    /// Creep elongation of the Maxwell branch \[m\].
-    pub creep_m: f64,
-    /// Tendon tension, both branches \[N\].
-    pub tendon_tension_n: f64,
-    /// Arm joint angles \[rad\] (kinematic mode: the rate-limited commanded angles).
-    pub arm_q: [f64; 6],
-    /// The object's vertical load on the arm \[N\]: the upward (world +z) component of every
-    /// contact force the arm and what it carries (links, hand, palm, strip, pad) exert on the
-    /// object, so an object hanging still in the grip reads its weight. What the arm's wrist force
-    /// sensor adds to the tool's own load ([`crate::wrist`]). MuJoCo sums its contact forces;
-    /// rapier, whose friction impulses stay inside its solver, takes it from the object's momentum
-    /// over the step. `None` where a backend cannot tell it.
-    pub tool_load_n: Option<f64>,
 }
 
 /// One MuJoCo simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a
@@ -606,9 +554,9 @@ impl Physics for Scene {
         self.shared.spec.physics.timestep_s
     }
 
-    fn snapshot(&self) -> Option<crate::frames::Snapshot> {
+    fn snapshot(&self) -> Option<Snapshot> {
         let d = &self.data;
-        Some(crate::frames::Snapshot {
+        Some(Snapshot {
             qpos: d.qpos().to_vec(),
             qvel: d.qvel().to_vec(),
             ctrl: d.ctrl().to_vec(),

@@ -4,7 +4,7 @@
 use super::world::RapierWorld;
 use crate::physics::config::Backend;
 use crate::physics::drive::{Drive, grip_in_hand};
-use crate::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel};
+use crate::physics::{Physics, PhysicsError, PhysicsReadout, SceneModel, Snapshot};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::{Pose, Vector};
 use std::sync::Arc;
@@ -87,7 +87,7 @@ impl Physics for RapierScene {
     /// Rapier's state in MuJoCo's layout: hinge and slide joints from the multibody, a free joint
     /// from its body's pose (velocity 0: only drawn contact forces use it), controls as commanded,
     /// activations 0.
-    fn snapshot(&self) -> Option<crate::frames::Snapshot> {
+    fn snapshot(&self) -> Option<Snapshot> {
         use mujoco_rs::mujoco_c::mjtJoint;
         let m = self.shared.model();
         let mut qpos = m.qpos0().to_vec();
@@ -107,7 +107,7 @@ impl Physics for RapierScene {
                 _ => {}
             }
         }
-        Some(crate::frames::Snapshot { qpos, qvel, ctrl: self.world.ctrl.clone(), act: vec![0.0; m.ffi().na as usize] })
+        Some(Snapshot { qpos, qvel, ctrl: self.world.ctrl.clone(), act: vec![0.0; m.ffi().na as usize] })
     }
 
     fn set_growth(&mut self, growth_m: f64) -> Result<(), PhysicsError> {
