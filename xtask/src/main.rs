@@ -4,7 +4,8 @@
 //! does not depend on it: `cargo xtask` fetches the library from PyPI first, then runs cargo.
 //!
 //! - `cargo xtask fetch`: unpack MuJoCo 3.17.0 from the PyPI wheel into `vendor/mujoco/lib`.
-//! - `cargo xtask main`: fetch, then run the main job (`tendril reproduce ...`).
+//! - `cargo xtask main`: fetch, install `tendril` (`cargo install --path . --locked`, reusing the
+//!   workspace's release build), then run the main job (`tendril reproduce ...`).
 //! - `cargo xtask test`: fetch, install the Python protocol clients into `vendor/venv`, then run
 //!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv; then build the Python
 //!   package into that venv and run its tests (`python/tests`, pytest).
@@ -144,11 +145,39 @@ fn build_book(extra: &[String]) -> Result<(), String> {
     run(Command::new(&mdbook).args(["build", "docs"]).args(extra).current_dir(&root))
 }
 
-/// The main job: reproduce the paper's results with the twin.
+/// The main job: install `tendril`, then reproduce the paper's results with the twin.
 fn run_main(extra: &[String]) -> Result<(), String> {
+    install_tendril()?;
     let mut reproduce = cargo();
     reproduce.args(["run", "--release", "--quiet", "--bin", "tendril", "--", "reproduce", "all"]).args(extra);
     run(&mut reproduce)
+}
+
+/// `cargo install --path . --locked`: builds `tendril` in the workspace's target folder (the
+/// release build `cargo run --release` uses, so the main job builds once) and copies it to the
+/// folder cargo installs binaries into, so the README's `tendril ...` commands run as typed.
+/// Says where it went, and how to put that folder on the PATH when it is not there.
+fn install_tendril() -> Result<(), String> {
+    run(cargo().args(["install", "--path", ".", "--locked", "--quiet"]))?;
+    let bin = install_bin_dir();
+    let on_path = std::env::var_os("PATH").is_some_and(|p| std::env::split_paths(&p).any(|d| d == bin));
+    eprintln!("xtask: installed tendril as {}", bin.join("tendril").display());
+    if !on_path {
+        eprintln!("xtask: {} is not on your PATH; add it with", bin.display());
+        eprintln!("    export PATH=\"{}:$PATH\"", bin.display());
+    }
+    Ok(())
+}
+
+/// Where `cargo install` puts binaries: `$CARGO_INSTALL_ROOT/bin`, else `$CARGO_HOME/bin`, else
+/// `~/.cargo/bin` (cargo's own order; an `install.root` in a cargo config is not read here).
+fn install_bin_dir() -> PathBuf {
+    let var = |name| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let root = var("CARGO_INSTALL_ROOT")
+        .or_else(|| var("CARGO_HOME"))
+        .or_else(|| var("HOME").map(|h| h.join(".cargo")))
+        .unwrap_or_else(|| PathBuf::from(".cargo"));
+    root.join("bin")
 }
 
 /// The whole test suite (what `.ci/run` runs): the workspace's tests, then the Python package's.
