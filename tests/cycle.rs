@@ -72,7 +72,7 @@ fn a_grasp_that_never_settles_times_out_and_lets_go_without_lifting() {
     assert_eq!(phases[phases.len() - 3..], [Phase::Grasp, Phase::Release, Phase::Done]);
     let last = report.rows.last().unwrap();
     assert!(last.object_height_m.abs() < 2e-3, "the object was lifted: {} m", last.object_height_m);
-    assert_eq!(last.twine_motor_rad, 0.0, "the finger let go");
+    assert!(last.twine_motor_rad.abs() < 1e-6, "the finger let go: twine at {} rad", last.twine_motor_rad);
 }
 
 #[test]

@@ -62,8 +62,8 @@ pub struct ChartArgs {
     /// 0.14,0.175]; each must lie within the mechanism's travel (`task.growth_m`, 0 to 0.3 m).
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     growth: Vec<f64>,
-    /// Finger: the pad heights on the sleeve \[m\] (`finger.pad_protrusion_m`) [default:
-    /// 0.0035,0.0045,0.0055,0.0065,0.0075; with --quick 0.0055].
+    /// Finger: the pad heights on the sleeve \[m\] (`finger.pad_protrusion_m`, 0.0005 to 0.0055 m)
+    /// [default: 0.0015,0.0025,0.0035,0.0045,0.0055; with --quick 0.0055].
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     pad_height: Vec<f64>,
     /// Hold: run folders to draw (each with its trace.csv), as NAME=DIR or DIR [default: run the
@@ -151,7 +151,7 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
                 let runs: Vec<(String, PathBuf)> = a
                     .runs
                     .iter()
-                    .map(|r| match r.split_once('=') {
+                    .map(|r| match r.rsplit_once('=') {
                         Some((name, dir)) => (name.to_string(), PathBuf::from(dir)),
                         None => (r.clone(), PathBuf::from(r)),
                     })

@@ -34,9 +34,10 @@ pub const LINK_M: f64 = 0.0175;
 /// Growth lengths of the full study \[m\]: the paper's 14 cm and two links either side.
 pub const GROWTH_M: [f64; 5] = [0.105, 0.1225, 0.14, 0.1575, 0.175];
 
-/// Pad heights of the full study \[m\]: the default 5.5 mm (the casing standing on the sleeve)
-/// and 1 and 2 mm either side (recessed into the sleeve, or on a spacer).
-pub const PAD_HEIGHT_M: [f64; 5] = [0.0035, 0.0045, 0.0055, 0.0065, 0.0075];
+/// Pad heights of the full study \[m\]: the default 5.5 mm (the 4 mm casing standing on the
+/// sleeve, the highest `finger.pad_protrusion_m` allows) and the casing recessed into the sleeve by
+/// 1 to 4 mm (at 1.5 mm only the bump stands out).
+pub const PAD_HEIGHT_M: [f64; 5] = [0.0015, 0.0025, 0.0035, 0.0045, 0.0055];
 
 /// What the study runs.
 #[derive(Debug, Clone)]
@@ -386,8 +387,13 @@ fn chart(summary: &[FingerRow]) -> Panels {
 }
 
 /// The size the numbers recommend: among those that held every run with feedback on for every
-/// object, the largest smallest hold margin over the objects; ties by the larger smallest contact
-/// area, then the shorter cycle. Said with its numbers against the paper's 14 cm, 5.5 mm.
+/// object, the gentlest whose frozen grip (feedback off) still carried every object to the end of
+/// the carry: the smallest largest grip force over the objects, ties by the shorter cycle. The
+/// hold margin is capped by the carry, so once a grip carries to its end a tighter one only
+/// squeezes harder (a pad recessed into the sleeve leaves the wrap's force to the strip, which the
+/// setpoint on the pad no longer bounds). If no size carried every object frozen, the largest
+/// smallest hold margin, ties by the larger smallest contact area, then the shorter cycle. Said
+/// with its numbers against the paper's 14 cm, 5.5 mm.
 pub fn recommend(summary: &[FingerRow]) -> String {
     let sizes =
         tendril_plot::grid::first_seen(summary.iter().map(|r| (r.growth_m.to_bits(), r.pad_height_m.to_bits())));
@@ -397,33 +403,43 @@ pub fn recommend(summary: &[FingerRow]) -> String {
     let min = |rs: &[&FingerRow], f: fn(&FingerRow) -> Option<f64>| {
         rs.iter().map(|r| f(r).unwrap_or(0.0)).fold(f64::INFINITY, f64::min)
     };
+    let max_grip =
+        |s: (u64, u64)| rows(s).iter().map(|r| r.peak_grip_mean_n.unwrap_or(f64::INFINITY)).fold(0.0, f64::max);
+    let cycle = |s: (u64, u64)| mean(rows(s).iter().filter_map(|r| r.cycle_mean_s)).unwrap_or(f64::INFINITY);
     let score = |s: (u64, u64)| {
         let rs = rows(s);
-        let cycle = mean(rs.iter().filter_map(|r| r.cycle_mean_s)).unwrap_or(f64::INFINITY);
-        (min(&rs, |r| r.margin_mean_s), min(&rs, |r| r.contact_area_mean_cm2), cycle)
+        (min(&rs, |r| r.margin_mean_s), min(&rs, |r| r.contact_area_mean_cm2), cycle(s))
     };
     let describe = |s: (u64, u64)| {
         let rs = rows(s);
         let (margin, area, cycle) = score(s);
         let held: usize = rs.iter().map(|r| r.held).sum();
         let runs: usize = rs.iter().map(|r| r.runs).sum();
+        let frozen: usize = rs.iter().map(|r| r.held_frozen).sum();
         let per_object: Vec<String> = rs
             .iter()
             .map(|r| format!("{} {}", r.object, r.margin_mean_s.map_or("-".into(), |m| format!("{m:.1} s"))))
             .collect();
         format!(
-            "growth {:.2} cm, pad {:.1} mm proud: held {held} of {runs} with feedback on; hold margin at least {margin:.1} s ({}), \
-             finger area on the object at least {area:.1} cm², mean cycle {cycle:.1} s",
+            "growth {:.2} cm, pad {:.1} mm proud: held {held} of {runs} with feedback on, {frozen} of {runs} carried \
+             frozen; hold margin at least {margin:.1} s ({}), grip force at most {:.1} N, finger area on the object \
+             at least {area:.1} cm², mean cycle {cycle:.1} s",
             f64::from_bits(s.0) * 100.0,
             f64::from_bits(s.1) * 1e3,
-            per_object.join(", ")
+            per_object.join(", "),
+            max_grip(s),
         )
     };
-    let best =
-        sizes.iter().copied().filter(|&s| rows(s).iter().all(|r| r.held == r.runs && r.runs > 0)).max_by(|&a, &b| {
+    let held: Vec<(u64, u64)> =
+        sizes.iter().copied().filter(|&s| rows(s).iter().all(|r| r.held == r.runs && r.runs > 0)).collect();
+    let carried = held.iter().copied().filter(|&s| rows(s).iter().all(|r| r.held_frozen == r.runs));
+    let gentlest = carried.min_by(|&a, &b| max_grip(a).total_cmp(&max_grip(b)).then(cycle(a).total_cmp(&cycle(b))));
+    let best = gentlest.or_else(|| {
+        held.iter().copied().max_by(|&a, &b| {
             let (sa, sb) = (score(a), score(b));
             sa.0.total_cmp(&sb.0).then(sa.1.total_cmp(&sb.1)).then(sb.2.total_cmp(&sa.2))
-        });
+        })
+    });
     let Some(best) = best else { return "recommended: none of the sizes held every run of every object".into() };
     let mut text = format!("recommended: {}", describe(best));
     let paper = (0.14_f64.to_bits(), 0.0055_f64.to_bits());

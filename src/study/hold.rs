@@ -29,6 +29,11 @@ struct History {
 }
 
 fn read_history(name: &str, dir: &Path) -> anyhow::Result<History> {
+    read_history_between(name, dir, f64::NEG_INFINITY, f64::INFINITY)
+}
+
+/// As [`read_history`], the rows from `from_min` to `to_min` only.
+fn read_history_between(name: &str, dir: &Path, from_min: f64, to_min: f64) -> anyhow::Result<History> {
     let path = dir.join("trace.csv");
     let err = |e: csv::Error| anyhow::anyhow!("{}: {e}", path.display());
     let mut reader = csv::Reader::from_path(&path).map_err(err)?;
@@ -51,16 +56,44 @@ fn read_history(name: &str, dir: &Path) -> anyhow::Result<History> {
             row[k] = record.get(c).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN);
         }
         row[0] /= 60.0;
-        rows.push(row);
+        if (from_min..=to_min).contains(&row[0]) {
+            rows.push(row);
+        }
     }
     let step = rows.len().div_ceil(MAX_POINTS).max(1);
     Ok(History { name: name.into(), rows: rows.into_iter().step_by(step).collect() })
 }
 
 /// Draws the runs' histories as `out/stem.png/.svg`: the force estimate, the true pad and grip
-/// forces (where the cell has ground truth) and the twine motor against its travel's end.
+/// forces (where the cell has ground truth) and the twine motor against its travel's end; a run
+/// longer than ten minutes gets two more rows, its first two minutes and its last (the release and
+/// the re-wrap, at full resolution).
 pub fn draw(runs: &[(String, PathBuf)], travel_rad: f64, out: &Path, stem: &str) -> anyhow::Result<Vec<PathBuf>> {
     let histories: Vec<History> = runs.iter().map(|(n, d)| read_history(n, d)).collect::<Result<_, _>>()?;
+    let end = histories.iter().flat_map(|h| h.rows.last()).map(|r| r[0]).fold(0.0, f64::max);
+    let mut windows = vec![(f64::NEG_INFINITY, f64::INFINITY, String::new())];
+    if end > 10.0 {
+        windows.push((0.0, 2.0, ", first 2 min".to_string()));
+        windows.push((end - 1.0, end, ", last minute".to_string()));
+    }
+    let mut panels = Vec::new();
+    let mut columns = 0;
+    for (from, to, label) in &windows {
+        let thinned: Vec<History> = if from.is_finite() {
+            runs.iter().map(|(n, d)| read_history_between(n, d, *from, *to)).collect::<Result<_, _>>()?
+        } else {
+            histories.iter().map(|h| History { name: h.name.clone(), rows: h.rows.clone() }).collect()
+        };
+        let row = history_panels(&thinned, travel_rad, label);
+        columns = row.len();
+        panels.extend(row);
+    }
+    let chart = Panels { title: "A long grasp: the grip's and the twine motor's history".into(), panels, columns };
+    Ok(tendril_plot::panels::render(&chart, out, stem)?)
+}
+
+/// One row of panels for `histories`: estimate, true forces (if any), twine.
+fn history_panels(histories: &[History], travel_rad: f64, label: &str) -> Vec<Panel> {
     let series = |k: usize, suffix: &str| {
         histories
             .iter()
@@ -72,15 +105,18 @@ pub fn draw(runs: &[(String, PathBuf)], travel_rad: f64, out: &Path, stem: &str)
             })
             .collect::<Vec<_>>()
     };
-    let end = histories.iter().flat_map(|h| h.rows.last()).map(|r| r[0]).fold(0.0, f64::max);
+    let (start, end) = histories
+        .iter()
+        .flat_map(|h| h.rows.iter())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| (a.min(r[0]), b.max(r[0])));
     let mut twine = series(4, "");
     twine.push(Series {
         name: "end of the travel".into(),
-        points: vec![(0.0, travel_rad), (end, travel_rad)],
+        points: vec![(start, travel_rad), (end, travel_rad)],
         mark: Mark::Line,
     });
     let mut panels = vec![Panel {
-        caption: "force estimate (eq. 8)".into(),
+        caption: format!("force estimate (eq. 8){label}"),
         x_desc: "time [min]".into(),
         y_desc: "[N]".into(),
         series: series(1, ""),
@@ -91,7 +127,7 @@ pub fn draw(runs: &[(String, PathBuf)], travel_rad: f64, out: &Path, stem: &str)
         let mut forces = truth;
         forces.extend(series(3, ", grip (strip and pad)"));
         panels.push(Panel {
-            caption: "true forces on the object (twin)".into(),
+            caption: format!("true forces on the object (twin){label}"),
             x_desc: "time [min]".into(),
             y_desc: "[N]".into(),
             series: forces,
@@ -99,15 +135,13 @@ pub fn draw(runs: &[(String, PathBuf)], travel_rad: f64, out: &Path, stem: &str)
         });
     }
     panels.push(Panel {
-        caption: "twine motor".into(),
+        caption: format!("twine motor{label}"),
         x_desc: "time [min]".into(),
         y_desc: "[rad]".into(),
         series: twine,
         y_range: Some((0.0, travel_rad * 1.1)),
     });
-    let columns = panels.len();
-    let chart = Panels { title: "A long grasp: the grip's and the twine motor's history".into(), panels, columns };
-    Ok(tendril_plot::panels::render(&chart, out, stem)?)
+    panels
 }
 
 /// Runs the shortened hour on `scenario` with the hold off (`held/`) and on (`released/`) into

@@ -56,11 +56,12 @@ impl Grasp {
     }
 }
 
-/// The grasps of the study: quick, the paper's 15 s and one settled grasp; full, fixed 15, 5 and
+/// The grasps of the study: quick, the paper's 15 s and the default settled grasp; full, fixed 15, 5 and
 /// 3 s and settled grasps in bands of ±5, 10 and 15 % with dwells of 0.5, 1 and 2 s.
 pub fn grasps(quick: bool) -> Vec<Grasp> {
     if quick {
-        return vec![Grasp::Fixed(15.0), Grasp::Settled { band_pct: 10.0, dwell_s: 1.0 }];
+        let default = tendril_control::settle::SettleConfig::default();
+        return vec![Grasp::Fixed(15.0), Grasp::Settled { band_pct: default.band_pct, dwell_s: default.dwell_s }];
     }
     let mut g: Vec<Grasp> = [15.0, 5.0, 3.0].into_iter().map(Grasp::Fixed).collect();
     for band_pct in [5.0, 10.0, 15.0] {
