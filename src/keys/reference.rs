@@ -24,6 +24,7 @@ const SWITCHED_ON: &[&str] = &[
     "[disturbance.push]\nimpulse_n_s = 0.3\nphase = \"lift\"\n[disturbance.dropout]\nduration_s = 0.5\nphase = \"lift\"\n",
     "[object]\nname = \"crimper\"\nfriction = 1.0\nposition_m = [0.0, 0.0]\nmass_kg = 0.1\nyaw_deg = 0.0\n",
     "[array]\n[[array.pads]]\narc_m = 0.012\nlambda1_nm = 1520.0\nlambda2_nm = 1530.0\n",
+    "[detector]\ntable = \"object-table.toml\"\n",
 ];
 
 /// One key of the reference.

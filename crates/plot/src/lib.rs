@@ -15,6 +15,7 @@ pub mod gain_map;
 pub mod grid;
 pub mod input;
 pub mod jitter;
+pub mod panels;
 pub mod placement;
 pub mod speed_accuracy;
 pub mod stability;

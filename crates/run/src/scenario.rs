@@ -8,6 +8,8 @@
 //! ```
 //! Everything else has the paper's or the model's documented defaults; see `scenarios/*.toml`.
 
+use super::detector::{Detection, DetectorConfig};
+use super::object_table::ObjectTable;
 use super::runner::ControlPlan;
 use super::summary::{Gains, RunIdentity};
 use serde::{Deserialize, Serialize};
@@ -99,6 +101,10 @@ pub struct PickPlaceScenario {
     /// `--bag` (docs/cell/ros2.md); the defaults are a Humble lab's.
     #[serde(default, skip_serializing_if = "Ros2Config::is_default")]
     pub ros2: Ros2Config,
+    /// A simulated object detector whose class chooses the setpoint and the controller's keys from
+    /// a per-object table; none by default (the scenario's own settings).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detector: Option<DetectorConfig>,
 }
 
 fn default_seed() -> u64 {
@@ -117,7 +123,9 @@ impl Validate for PickPlaceScenario {
     fn prepare(table: &mut toml::Table, file: &std::path::Path) {
         super::paths::resolve_models(table, file);
         super::paths::resolve_object(table, file);
+        super::paths::resolve_detector_table(table, file);
         super::backend_defaults::fill_backend_defaults(table);
+        super::detector::apply(table);
     }
 
     fn validate(&self, at: &mut Checker) {
@@ -140,6 +148,10 @@ impl Validate for PickPlaceScenario {
         at.section("hardware", &self.hardware);
         at.section("disturbance", &self.disturbance);
         at.section("ros2", &self.ros2);
+        if let Some(d) = &self.detector {
+            at.section("detector", d);
+            super::detector::check(d, &self.object.label(), at);
+        }
         at.require(
             "disturbance.push",
             self.disturbance.push.is_none() || self.physics.backend == tendril_twin::physics::Backend::Mujoco,
@@ -161,6 +173,21 @@ impl Validate for PickPlaceScenario {
         at.require("task.wrap_contact_n", self.task.wrap_contact_n < self.estimator.range_n, || {
             format!("must be below the sensor's range {} N, got {}", self.estimator.range_n, self.task.wrap_contact_n)
         });
+        let settled = &self.task.settled_grasp;
+        let resolution_n = tendril_control::settle::RESOLUTION_N;
+        at.require(
+            "task.settled_grasp.band_pct",
+            !settled.enabled || settled.band_n(self.setpoint_n) >= resolution_n,
+            || {
+                format!(
+                    "a band of ±{:.2} mN around the {} N setpoint is finer than the sensor's resolution ({} mN, paper \
+                 Sec. IV-B): it can never be told from noise",
+                    settled.band_n(self.setpoint_n) * 1e3,
+                    self.setpoint_n,
+                    resolution_n * 1e3
+                )
+            },
+        );
         let tendon_max_m = self.gripper.tendon_pull_m(self.gripper.twine_max_deg.to_radians());
         at.require("gripper.twine_max_deg", tendon_max_m <= self.finger.twine_max_m + 1e-9, || {
             format!(
@@ -308,6 +335,14 @@ impl PickPlaceScenario {
     /// not load, when no run can start).
     pub fn object_mass_kg(&self) -> f64 {
         self.object.mass_kg.unwrap_or_else(|| self.object.model().map_or(f64::NAN, |m| m.mass_kg))
+    }
+
+    /// What the detector reported for this run (`None` without a `[detector]`, or when its table
+    /// does not read, which validation refuses): the same draw that chose the run's settings.
+    pub fn detection(&self) -> Option<Detection> {
+        let d = self.detector.as_ref()?;
+        let table = ObjectTable::read(&d.table).ok()?;
+        Some(d.draw(self.seed, &self.object.label(), &table.class_names(), table.fallback.is_some()))
     }
 
     /// What the control side needs.

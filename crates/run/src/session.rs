@@ -439,9 +439,12 @@ impl<C: Cell> Session<C> {
         let sensor_drop = slip.events().dropped_s.map(|t| Drop { cell_time_s: t, phase: phase_at(&rows, t) });
         let has_truth = rows.first().is_some_and(|r| r.true_force_n.is_finite());
         let drop = if has_truth { self.truth_drop } else { sensor_drop };
+        let grasp = self.sequencer.grasp_outcome();
+        let timed_out = grasp.is_some_and(|g| g.end == tendril_control::settle::GraspEnd::TimedOut);
         let outcome = match (&error, drop) {
             (Some(_), _) => Outcome::Error,
             (None, Some(_)) => Outcome::Dropped,
+            (None, None) if timed_out => Outcome::NotGrasped,
             (None, None) => Outcome::Held,
         };
         let metrics = control_metrics(&rows, drop.map(|d| d.cell_time_s));
@@ -470,6 +473,8 @@ impl<C: Cell> Session<C> {
             rows,
             device_timing,
             array,
+            grasp,
+            hold: self.sequencer.hold_record(),
         };
         (report, self.trace.take())
     }

@@ -282,6 +282,12 @@ impl SimCell {
         self.scene.as_ref()?.contact_census()
     }
 
+    /// The area of the finger's faces touching the object now \[m²\] (MuJoCo only; see
+    /// [`crate::physics::Scene::contact_area_m2`]).
+    pub fn contact_area_m2(&self) -> Option<f64> {
+        self.scene.as_ref()?.contact_area_m2()
+    }
+
     /// The frames recorded so far, if [`SimCell::record_frames`] was asked for and the backend has
     /// a MuJoCo state.
     pub fn take_frames(&mut self) -> Option<crate::frames::FrameLog> {

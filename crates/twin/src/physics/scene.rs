@@ -591,6 +591,37 @@ impl Scene {
     pub fn object_geoms(&self) -> &[usize] {
         &self.shared.ids.object_geoms
     }
+
+    /// The area of the finger's faces that touch the object now \[m²\]: each box of the finger
+    /// (a strip link, a pad's casing) in contact with the object counts with its largest face
+    /// (its length by the strip's width), once however many points touch. The area the wrap lies
+    /// on, at the links' resolution; a pad's bump counts through its casing.
+    pub fn contact_area_m2(&self) -> f64 {
+        let ids = &self.shared.ids;
+        let m = &self.shared.model;
+        let mut touching: Vec<usize> = Vec::new();
+        for c in self.data.contact() {
+            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+            let finger = if ids.object_geoms.contains(&g2) { g1 } else { g2 };
+            let object = if finger == g1 { g2 } else { g1 };
+            if c.efc_address >= 0 && ids.object_geoms.contains(&object) && ids.finger_geoms.contains(&finger) {
+                // The bump touches for its casing: one face per pad.
+                let face = if ids.pad_geoms.contains(&finger) { ids.pad_geoms[0] } else { finger };
+                if !touching.contains(&face) {
+                    touching.push(face);
+                }
+            }
+        }
+        touching
+            .into_iter()
+            .filter(|&g| m.geom_type()[g] == mujoco_rs::mujoco_c::_mjtGeomBase::mjGEOM_BOX)
+            .map(|g| {
+                let mut half = m.geom_size()[g];
+                half.sort_by(f64::total_cmp);
+                4.0 * half[1] * half[2]
+            })
+            .sum()
+    }
 }
 
 impl Physics for Scene {
@@ -677,6 +708,10 @@ impl Physics for Scene {
 
     fn contact_census(&self) -> Option<ContactCensus> {
         self.census.clone()
+    }
+
+    fn contact_area_m2(&self) -> Option<f64> {
+        Some(Scene::contact_area_m2(self))
     }
 
     fn set_object_force(&mut self, force_n: [f64; 3]) -> Result<(), PhysicsError> {
