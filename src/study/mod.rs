@@ -11,12 +11,15 @@
 //!   fluctuation, rise, overshoot, peak force.
 //! - [`jitter`]: the real path against the virtual devices under injected timing jitter, against
 //!   the twin (runs in real time, one at a time).
+//! - [`produce`]: the produce items against Hertz between plates, and each item's window of
+//!   setpoints that holds or harvests it without bruising it.
 
 pub mod controllers;
 pub mod convergence;
 pub mod gain_map;
 pub mod jitter;
 pub mod placement;
+pub mod produce;
 pub mod speed_accuracy;
 pub mod stability;
 

@@ -16,6 +16,7 @@ pub mod grid;
 pub mod input;
 pub mod jitter;
 pub mod placement;
+pub mod produce;
 pub mod speed_accuracy;
 pub mod stability;
 pub mod style;

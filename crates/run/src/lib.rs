@@ -12,6 +12,8 @@ pub mod metrics;
 pub mod output;
 mod paths;
 pub mod plan;
+mod produce_defaults;
+pub mod produce_summary;
 pub mod real;
 pub mod report;
 pub mod runner;

@@ -59,6 +59,9 @@ pub struct RunReport {
     pub device_timing: Option<tendril_cell::DeviceTiming>,
     /// A sensor array's figures and slip cue (`None` with the paper's single pad).
     pub array: Option<super::array_summary::ArraySummary>,
+    /// A produce item's damage and stem at the end of the run (`None` for a rigid object, or
+    /// without ground truth).
+    pub produce: Option<tendril_cell::ProduceTruth>,
 }
 
 /// Consecutive invalid sensor samples (no estimate: non-finite, or below the calibration curve)
