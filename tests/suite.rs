@@ -32,6 +32,7 @@ mod object_files;
 mod physics_metamorphic;
 mod physics_validation;
 mod plot;
+mod produce;
 mod protocol_props;
 mod render;
 mod results_durability;

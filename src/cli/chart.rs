@@ -19,8 +19,10 @@ pub struct ChartArgs {
     /// the detector's accuracy; prints the pairs as a table) or `finger` (growth length and pad
     /// height against hold margin, contact area, peak force and cycle time; prints the size its
     /// numbers recommend) or `hold` (a long grasp's grip and twine motor over time: the runs given
-    /// with `--run`, or the shortened hour run with the hold off and on).
-    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter", "placement", "settle", "detector", "finger", "hold"])]
+    /// with `--run`, or the shortened hour run with the hold off and on) or `produce` (the
+    /// produce items between plates against Hertz, and each one's window of setpoints that holds
+    /// or harvests it without bruising it; prints the windows).
+    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter", "placement", "settle", "detector", "finger", "hold", "produce"])]
     study: String,
     /// Scenario to study [default: convergence, gain-map, controllers, placement and settle the three objects; speed-accuracy the crimper (its fine reference drops it too, so
     /// drop times compare), stability the hammer (the heaviest load)].
@@ -161,6 +163,15 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
                 study::hold::draw(&runs, scenario.gripper.twine_max_deg.to_radians(), &out, "hold")?
             }
         }
+        "produce" => {
+            let plan = study::produce::Plan::new(&a.scenario, a.quick, &a.seeds)?;
+            let outcome = study::produce::run(&plan, &out, a.threads)?;
+            for w in &outcome.windows {
+                let why = if w.reason.is_empty() { String::new() } else { format!(": {}", w.reason) };
+                emit(&format!("{} ({}): window {}{why}\n", w.item, w.task, w.text()));
+            }
+            outcome.files
+        }
         "jitter" => {
             let seeds = if a.seeds.is_empty() { if a.quick { vec![1] } else { vec![1, 2] } } else { a.seeds.clone() };
             study::jitter::run(&first("scenarios/short-lift.toml"), &study::jitter::cases(a.quick), &seeds, &out)?
@@ -193,7 +204,19 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
     if a.quick && a.finest_step.is_some() {
         anyhow::bail!("--finest-step: the --quick plan has no finest setting (default, step/2 and links x2 only)");
     }
-    let plan = if a.quick { Plan::quick(dt, links) } else { Plan::full(dt, links, finest) };
+    // A produce item's study refines its flex as well (the same plan with or without --quick).
+    let produce = base.object.model()?.produce;
+    let plan = match produce {
+        Some(item) => {
+            let flex = study::convergence::FlexSetting {
+                count: base.produce.count.unwrap_or(item.count[0]),
+                dof: base.produce.dof.unwrap_or(item.dof),
+            };
+            study::convergence::Plan::produce(dt, links, flex)
+        }
+        None if a.quick => Plan::quick(dt, links),
+        None => Plan::full(dt, links, finest),
+    };
     let seeds = if a.seeds.is_empty() { vec![1, 2, 3] } else { a.seeds.clone() };
     let cases: Vec<Case> = scenarios
         .into_iter()

@@ -28,6 +28,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("crates/twin/src/wrist.rs", include_str!("../../crates/twin/src/wrist.rs")),
     ("crates/twin/src/disturbance.rs", include_str!("../../crates/twin/src/disturbance.rs")),
     ("crates/twin/src/physics/config.rs", include_str!("../../crates/twin/src/physics/config.rs")),
+    ("crates/twin/src/physics/produce_config.rs", include_str!("../../crates/twin/src/physics/produce_config.rs")),
     ("crates/drivers/src/config.rs", include_str!("../../crates/drivers/src/config.rs")),
     ("crates/hyperion/src/fbg_map.rs", include_str!("../../crates/hyperion/src/fbg_map.rs")),
     ("crates/ros2/src/config.rs", include_str!("../../crates/ros2/src/config.rs")),

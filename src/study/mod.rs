@@ -17,6 +17,8 @@
 //! - [`hold`]: a long grasp's grip and twine motor over time, the hold off and on.
 //! - [`finger`]: the finger's growth length and pad height against hold margin, contact area, peak
 //!   force and cycle time, and the size its numbers recommend.
+//! - [`produce`]: the produce items against Hertz between plates, and each item's window of
+//!   setpoints that holds or harvests it without bruising it.
 
 pub mod controllers;
 pub mod convergence;
@@ -26,6 +28,7 @@ pub mod gain_map;
 pub mod hold;
 pub mod jitter;
 pub mod placement;
+pub mod produce;
 pub mod settle;
 pub mod speed_accuracy;
 pub mod stability;

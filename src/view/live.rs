@@ -451,6 +451,7 @@ mod tests {
             grip_force_n: 2.0,
             tool_load_n: 3.4,
             array: Default::default(),
+            produce: None,
         }
     }
 

@@ -17,6 +17,7 @@ pub mod input;
 pub mod jitter;
 pub mod panels;
 pub mod placement;
+pub mod produce;
 pub mod speed_accuracy;
 pub mod stability;
 pub mod style;

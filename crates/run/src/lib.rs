@@ -15,6 +15,8 @@ pub mod object_table;
 pub mod output;
 mod paths;
 pub mod plan;
+mod produce_defaults;
+pub mod produce_summary;
 pub mod real;
 pub mod report;
 pub mod ros2;

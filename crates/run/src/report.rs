@@ -79,6 +79,9 @@ pub struct RunReport {
     pub grasp: Option<GraspOutcome>,
     /// What the long hold did (`task.hold`) and how far the twine went.
     pub hold: HoldRecord,
+    /// A produce item's damage and stem at the end of the run (`None` for a rigid object, or
+    /// without ground truth).
+    pub produce: Option<tendril_cell::ProduceTruth>,
 }
 
 /// Consecutive invalid sensor samples (no estimate: non-finite, or below the calibration curve)

@@ -24,7 +24,9 @@ use tendril_fbg::estimate::ForceCalibration;
 use tendril_fbg::{InterrogatorConfig, SensorConfig};
 use tendril_ros2::Ros2Config;
 use tendril_twin::disturbance::DisturbanceConfig;
-use tendril_twin::physics::{FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, SceneModel, SceneSpec};
+use tendril_twin::physics::{
+    FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, ProduceConfig, SceneModel, SceneSpec,
+};
 use tendril_twin::sim::{EnvironmentConfig, SimCell};
 use tendril_twin::wrist::WristConfig;
 
@@ -53,6 +55,10 @@ pub struct PickPlaceScenario {
     pub control_rate_hz: f64,
     /// The object.
     pub object: ObjectConfig,
+    /// A produce item's properties within their literature range, its harvest and its flex's
+    /// numerics (read when the object is a produce item; docs/guide/objects.md).
+    #[serde(default, skip_serializing_if = "ProduceConfig::is_default")]
+    pub produce: ProduceConfig,
     /// The force controller: `type` (default `"pid"`) and that type's gains and limits.
     #[serde(default)]
     pub controller: ControllerConfig,
@@ -126,6 +132,7 @@ impl Validate for PickPlaceScenario {
         super::paths::resolve_detector_table(table, file);
         super::backend_defaults::fill_backend_defaults(table);
         super::detector::apply(table);
+        super::produce_defaults::fill_produce_defaults(table);
     }
 
     fn validate(&self, at: &mut Checker) {
@@ -134,6 +141,7 @@ impl Validate for PickPlaceScenario {
         // The sections first: a cross-check below that reads a bad value (estimator.range_n = nan)
         // must not be reported on the key that reads it (setpoint_n).
         at.section("object", &self.object);
+        at.section("produce", &self.produce);
         at.section("controller", &self.controller);
         at.section("task", &self.task);
         at.section("gripper", &self.gripper);
@@ -308,6 +316,7 @@ impl PickPlaceScenario {
                 })
                 .collect(),
             arm_q0: self.task.home_deg.map(f64::to_radians),
+            produce: self.produce.clone(),
         }
     }
 

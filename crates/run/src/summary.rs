@@ -137,6 +137,10 @@ pub struct RunSummary {
     /// With a `[detector]`: the class it reported and whose settings the run used.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub detection: Option<super::detector::Detection>,
+    /// With a produce item: the damage the grip did and the harvest's end (absent for a rigid
+    /// object).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub produce: Option<super::produce_summary::ProduceSummary>,
     /// MuJoCo's warnings during the run (see [`tendril_twin::mujoco_log`]), at most
     /// [`tendril_twin::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
     #[serde(default)]
@@ -157,13 +161,15 @@ impl RunSummary {
 
     /// The column names of a flattened summary, in order (nested fields dotted: `gains.kp`).
     pub fn columns() -> Vec<String> {
-        // A sensor array's columns too, so that one results file holds runs with and without one
-        // (empty for the paper's single pad); a real cell's device timing is not a sweep's.
+        // A sensor array's and a produce item's columns too, so that one results file holds runs
+        // with and without them (empty for the paper's single pad and a rigid object); a real
+        // cell's device timing is not a sweep's.
         let with_array = RunSummary {
             array: Some(Default::default()),
             grasp_duration_s: Some(0.0),
             hold: Some(Default::default()),
             detection: Some(Default::default()),
+            produce: Some(Default::default()),
             ..RunSummary::default()
         };
         flatten_summary(&with_array).into_iter().map(|(k, _)| k).collect()
@@ -204,6 +210,15 @@ impl RunSummary {
             grasp_duration_s: None,
             hold: hold_summary(report),
             detection: None,
+            produce: report.produce.as_ref().map(|p| {
+                super::produce_summary::ProduceSummary::new(
+                    p,
+                    report.outcome,
+                    report.drop,
+                    report.motion_start_s,
+                    &report.rows,
+                )
+            }),
             warnings: Vec::new(),
         }
     }
@@ -295,6 +310,9 @@ pub fn render_text(s: &RunSummary) -> String {
     if let Some(a) = &s.array {
         out += &render_array(a);
     }
+    if let Some(p) = &s.produce {
+        out += &render_produce(p);
+    }
     out += &format!(
         "  simulated {:.1} s in {:.2} s wall ({}x real time), {:.2} s of CPU ({}x)\n",
         s.sim_time_s,
@@ -303,6 +321,35 @@ pub fn render_text(s: &RunSummary) -> String {
         s.cpu_time_s,
         speed_factor(s.sim_s_per_cpu_s)
     );
+    out
+}
+
+/// A produce item's lines of the text summary: the damage, and the harvest's end.
+fn render_produce(p: &super::produce_summary::ProduceSummary) -> String {
+    let mut out = format!(
+        "  contact pressure   peak {:.0} kPa ({}), bruise threshold {:.0} kPa: {}\n",
+        p.peak_pressure_kpa,
+        if p.peak_at.is_empty() { "no contact" } else { p.peak_at.as_str() },
+        p.bruise_threshold_kpa,
+        if p.bruised {
+            format!("bruised, {:.1} mm² above it at most, for {:.2} s", p.bruise_area_mm2, p.time_above_s)
+        } else {
+            "not bruised".into()
+        }
+    );
+    if let Some(share) = p.bump_share {
+        out += &format!("  pad on the item    the bump carries {:.0} % of the pad's force while held\n", 100.0 * share);
+    }
+    if let Some(h) = &p.harvest {
+        out += &format!("  harvest            {h}");
+        if let Some(t) = p.detached_s {
+            out += &format!(", the stem let go {t:.2} s after the arm started moving");
+        }
+        if let (Some(max), Some(d)) = (p.max_stem_tension_n, p.detach_n) {
+            out += &format!(" (stem tension up to {max:.2} N, lets go at {d:.2} N)");
+        }
+        out += "\n";
+    }
     out
 }
 
