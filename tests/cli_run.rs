@@ -164,6 +164,21 @@ fn sweep_resume_and_shards_merge_to_the_same_runs() {
 }
 
 #[test]
+fn a_sweep_with_bag_keeps_each_runs_directory_and_its_bag() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = write_sweep(dir.path());
+    let out_dir = dir.path().join("out");
+    let out = tendril(&["sweep", sweep.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--bag"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for id in 0..4 {
+        let run = out_dir.join("runs").join(id.to_string());
+        let trace = std::fs::read_to_string(run.join("trace.csv")).unwrap();
+        let ticks = tendril_ros2::bag::read_bag(&run.join("bag"), Some(&["/tendril/control_tick"])).unwrap();
+        assert_eq!(ticks.len(), trace.lines().count() - 1, "run {id}: one control tick a trace row");
+    }
+}
+
+#[test]
 fn a_sweep_with_an_unknown_key_fails_before_running_anything() {
     let dir = tempfile::tempdir().unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/crimper.toml");

@@ -193,6 +193,7 @@ fn writers_on_a_full_device_report_the_error() {
         grip_force_n: 0.0,
         tool_load_n: f64::NAN,
         array: Default::default(),
+        produce: None,
     };
     let wrote = (0..100).all(|_| trace.write(&r).is_ok());
     assert!(!wrote || trace.flush().is_err());

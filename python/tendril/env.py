@@ -42,8 +42,17 @@ End
 
 Info
     ``time_s``, ``phase``, the ground truth (``true_force_n``, ``grip_force_n``,
-    ``object_height_m``, ``slip_speed_m_s``, ``in_contact``), ``dropped``; at the end also
-    ``summary`` (``summary.json``'s content).
+    ``object_height_m``, ``slip_speed_m_s``, ``in_contact``), ``dropped``; with a produce item
+    (``scenarios/cherry-tomato.toml``, ...) also ``produce``: the contact pressure now and its peak
+    so far [kPa], the bruise threshold [kPa], ``bruised``, the stem's tension [N] and ``on_plant``;
+    at the end also ``summary`` (``summary.json``'s content, a produce item's under ``produce``).
+
+Domain randomisation
+    ``randomize={"produce.modulus_pa": (3e5, 8e5), "object.friction": (0.4, 0.7), ...}``: at
+    every reset each key is drawn uniformly from its range with the environment's generator (so a
+    seeded sequence repeats) and set for the episode, before ``options["set"]``. Any scenario key
+    with a number takes a range: a produce item's properties within their literature range, its
+    friction, mass, the setpoint. ``info["randomized"]`` holds the episode's draws.
 
 Render
     ``render_mode="rgb_array"``: ``render()`` returns the scene as MuJoCo's offscreen renderer
@@ -111,6 +120,7 @@ class GripEnv(gymnasium.Env):
         render_width=640,
         render_height=480,
         models=None,
+        randomize=None,
     ):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode: expected None or 'rgb_array', got {render_mode!r}")
@@ -121,6 +131,8 @@ class GripEnv(gymnasium.Env):
         self._path = os.fspath(scenario) if scenario is not None else DEFAULT_SCENARIO
         self._set = _as_dict(set)
         self._overlay = overlay
+        self._randomize = _ranges(randomize)
+        self._drawn = {}
         self.drop_penalty = float(drop_penalty)
         self.hold_reward = float(hold_reward)
         self.band = float(band)
@@ -147,6 +159,9 @@ class GripEnv(gymnasium.Env):
         super().reset(seed=seed)
         self._end()
         overrides = dict(self._set)
+        # Domain randomisation: each range drawn with the environment's generator.
+        self._drawn = {key: float(self.np_random.uniform(low, high)) for key, (low, high) in self._randomize.items()}
+        overrides.update(self._drawn)
         overrides.update(_as_dict((options or {}).get("set")))
         # The twin's seed: the one given, else drawn from the environment's generator (seeded by
         # an earlier reset(seed=...)), so every episode differs and a seeded sequence repeats.
@@ -244,6 +259,8 @@ class GripEnv(gymnasium.Env):
 
     def _info(self, seen, row):
         info = {"dropped": self._dropped}
+        if self._drawn:
+            info["randomized"] = dict(self._drawn)
         if seen is not None:
             info["time_s"] = seen["time_s"]
             info["phase"] = seen["phase"]
@@ -251,6 +268,8 @@ class GripEnv(gymnasium.Env):
             info["true_force_n"] = truth.get("sensor_force_n", math.nan)
             for key in ("grip_force_n", "object_height_m", "slip_speed_m_s", "in_contact"):
                 info[key] = truth.get(key)
+            if truth.get("produce") is not None:
+                info["produce"] = dict(truth["produce"])
         elif row is not None:
             info["time_s"] = row["time_s"]
             info["phase"] = row["phase"]
@@ -287,4 +306,20 @@ def _as_dict(set):
         if not sep:
             raise ValueError(f"set: expected \"key=value\", got {item!r}")
         out[key.strip()] = value.strip()
+    return out
+
+
+def _ranges(randomize):
+    """``{key: (low, high)}`` checked: each key a string, each range two finite numbers, low <= high."""
+    out = {}
+    for key, bounds in dict(randomize or {}).items():
+        if not isinstance(key, str):
+            raise TypeError(f"randomize: a key must be a scenario key (str), got {key!r}")
+        try:
+            low, high = (float(b) for b in bounds)
+        except (TypeError, ValueError):
+            raise ValueError(f"randomize: {key}: expected a (low, high) pair of numbers, got {bounds!r}") from None
+        if not (math.isfinite(low) and math.isfinite(high) and low <= high):
+            raise ValueError(f"randomize: {key}: expected finite low <= high, got ({low}, {high})")
+        out[key] = (low, high)
     return out

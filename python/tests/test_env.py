@@ -7,7 +7,7 @@ from gymnasium.utils.env_checker import check_env
 
 import tendril
 from tendril.env import GripEnv
-from conftest import SHORT_LIFT
+from conftest import ROOT, SHORT_LIFT
 
 
 def test_the_environment_passes_gymnasiums_checks():
@@ -115,3 +115,40 @@ def test_the_reward_ranks_a_grip_at_the_setpoint_above_a_hard_squeeze():
     squeeze, squeeze_outcome = episode(3.0)
     assert near_outcome == squeeze_outcome == "held"
     assert near > squeeze + 0.5
+
+
+CHERRY = ROOT / "scenarios" / "cherry-tomato.toml"
+#: The cherry tomato's task shortened: the grasp and the moves a few seconds each.
+SHORT = {"task.grasp_s": 3.0, "task.lift_s": 2.0, "task.transfer_s": 1.0, "task.lower_s": 1.0}
+
+
+def test_a_produce_item_reports_its_damage_in_the_info():
+    env = GripEnv(CHERRY, set=SHORT)
+    _, info = env.reset(seed=1)
+    assert info["produce"]["bruise_threshold_kpa"] == pytest.approx(150.0)
+    peak = 0.0
+    terminated = truncated = False
+    while not (terminated or truncated):
+        _, _, terminated, truncated, info = env.step(np.array([0.0], dtype=np.float32))
+        if "produce" in info:
+            assert info["produce"]["peak_pressure_kpa"] >= peak - 1e-9, "the peak so far never falls"
+            peak = info["produce"]["peak_pressure_kpa"]
+    assert peak > 0.0
+    assert info["summary"]["produce"]["peak_pressure_kpa"] == pytest.approx(peak)
+    env.close()
+
+
+def test_randomize_draws_each_key_per_episode_and_a_seeded_sequence_repeats():
+    ranges = {"produce.modulus_pa": (3e5, 8e5), "produce.bruise_pa": (1e5, 2e5)}
+    env = GripEnv(CHERRY, set=SHORT, randomize=ranges)
+    _, first = env.reset(seed=4)
+    _, second = env.reset()
+    for key, (low, high) in ranges.items():
+        assert low <= first["randomized"][key] <= high
+    assert first["randomized"] != second["randomized"], "each episode draws anew"
+    assert first["produce"]["bruise_threshold_kpa"] == pytest.approx(first["randomized"]["produce.bruise_pa"] / 1e3)
+    _, again = env.reset(seed=4)
+    assert again["randomized"] == first["randomized"], "a seeded reset draws the same"
+    env.close()
+    with pytest.raises(ValueError, match="low <= high"):
+        GripEnv(CHERRY, randomize={"produce.modulus_pa": (8e5, 3e5)})

@@ -200,3 +200,15 @@ def test_a_sensor_arrays_pads_are_in_the_trace_and_the_observation(tmp_path):
     observation = session.observation()
     assert len(observation["array_force_n"]) == 2
     assert observation["control_force_n"] == observation["force_n"]
+
+
+def test_a_produce_run_has_its_damage_in_the_summary_and_the_trace():
+    cherry = ROOT / "scenarios" / "cherry-tomato.toml"
+    short = {"task.grasp_s": 3.0, "task.lift_s": 2.0, "task.transfer_s": 1.0, "task.lower_s": 1.0}
+    run = tendril.run(tendril.load(cherry, set=short))
+    produce = run.summary["produce"]
+    assert produce["peak_pressure_kpa"] > 0.0 and produce["bruise_threshold_kpa"] == 150.0
+    assert produce["bruised"] == (produce["peak_pressure_kpa"] > 150.0)
+    for column in ("pressure_kpa", "bruise_area_mm2", "stem_tension_n", "on_plant", "bump_force_n"):
+        assert column in run.trace, column
+    assert run.trace["pressure_kpa"].max() <= produce["peak_pressure_kpa"] + 1e-9

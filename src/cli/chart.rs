@@ -13,10 +13,18 @@ pub struct ChartArgs {
     /// `stability`, `gain-map`, `controllers` (each force controller under disturbances) or
     /// `jitter` (the real path against the virtual devices under injected timing jitter, in real
     /// time: about 14 s a run) or `placement` (FBG sensor layouts along the finger; prints the
-    /// layout its numbers recommend).
-    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter", "placement"])]
+    /// layout its numbers recommend), `settle` (grasp until settled against fixed grasps: cycle
+    /// time and held runs; prints the settled grasp its numbers recommend) or `detector` (settings
+    /// chosen by a detected class: each object with each class's settings, and held runs against
+    /// the detector's accuracy; prints the pairs as a table) or `finger` (growth length and pad
+    /// height against hold margin, contact area, peak force and cycle time; prints the size its
+    /// numbers recommend) or `hold` (a long grasp's grip and twine motor over time: the runs given
+    /// with `--run`, or the shortened hour run with the hold off and on) or `produce` (the
+    /// produce items between plates against Hertz, and each one's window of setpoints that holds
+    /// or harvests it without bruising it; prints the windows).
+    #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter", "placement", "settle", "detector", "finger", "hold", "produce"])]
     study: String,
-    /// Scenario to study [default: convergence, gain-map, controllers and placement the three objects; speed-accuracy the crimper (its fine reference drops it too, so
+    /// Scenario to study [default: convergence, gain-map, controllers, placement and settle the three objects; speed-accuracy the crimper (its fine reference drops it too, so
     /// drop times compare), stability the hammer (the heaviest load)].
     #[arg(long)]
     scenario: Vec<PathBuf>,
@@ -30,8 +38,8 @@ pub struct ChartArgs {
     /// side by side do not slow each other's figures (beyond shared caches).
     #[arg(long, default_value_t = 0, value_parser = super::sweep::threads_or_all)]
     threads: usize,
-    /// Convergence, controllers, jitter and placement: the seeds of every case [default: convergence 1,2,3; placement 1-10, with --quick 1;
-    /// controllers 1-10, with --quick 1,2; jitter 1,2, with --quick 1].
+    /// Convergence, controllers, jitter, placement, settle, detector and finger: the seeds of every case [default: convergence 1,2,3; placement 1-10, with --quick 1;
+    /// controllers 1-10, with --quick 1,2; jitter 1,2, with --quick 1; settle and detector 1-10, with --quick 1 (detector 1,2); finger 1,2, with --quick 1].
     #[arg(long, value_delimiter = ',')]
     seeds: Vec<u64>,
     /// Convergence: the physics backend (`mujoco` or `rapier`) [default: the scenario's].
@@ -48,6 +56,22 @@ pub struct ChartArgs {
     /// Gain map: the Kp values \[(°/s)/N\] [default: 2,5,10,20,50,100,200; with --quick 5,20].
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     kp: Vec<f64>,
+    /// Detector: the per-object table the detected class chooses settings from [default:
+    /// scenarios/object-table.toml].
+    #[arg(long, value_name = "FILE")]
+    table: Option<PathBuf>,
+    /// Finger: the growth lengths \[m\] [default: 0.105,0.1225,0.14,0.1575,0.175; with --quick
+    /// 0.14,0.175]; each must lie within the mechanism's travel (`task.growth_m`, 0 to 0.3 m).
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    growth: Vec<f64>,
+    /// Finger: the pad heights on the sleeve \[m\] (`finger.pad_protrusion_m`, 0.0005 to 0.0055 m)
+    /// [default: 0.0015,0.0025,0.0035,0.0045,0.0055; with --quick 0.0055].
+    #[arg(long, value_delimiter = ',', value_name = "LIST")]
+    pad_height: Vec<f64>,
+    /// Hold: run folders to draw (each with its trace.csv), as NAME=DIR or DIR [default: run the
+    /// shortened hour with the hold off and on].
+    #[arg(long = "run", value_name = "DIR")]
+    runs: Vec<String>,
     /// Gain map: the Ki values \[(°/s)/(N·s)\] [default: 0,0.05,0.5,5,50; with --quick 0.05].
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     ki: Vec<f64>,
@@ -97,6 +121,57 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             emit(&format!("{}\n", outcome.recommendation));
             outcome.files
         }
+        "settle" => {
+            let seeds =
+                if a.seeds.is_empty() { if a.quick { vec![1] } else { (1..=10).collect() } } else { a.seeds.clone() };
+            let grasps = study::settle::grasps(a.quick);
+            let outcome = study::settle::run(&objects_or(&a.scenario), &grasps, &seeds, &out, a.threads)?;
+            emit(&format!("{}\n", outcome.recommendation));
+            outcome.files
+        }
+        "detector" => {
+            let table = a.table.clone().unwrap_or_else(|| PathBuf::from(study::detector::DEFAULT_TABLE));
+            let table =
+                std::fs::canonicalize(&table).map_err(|e| anyhow::anyhow!("--table {}: {e}", table.display()))?;
+            let plan = study::detector::Plan::new(objects_or(&a.scenario), table, a.quick, &a.seeds);
+            let outcome = study::detector::run(&plan, &out, a.threads)?;
+            emit(&study::detector::pairs_markdown(&outcome.pairs));
+            outcome.files
+        }
+        "finger" => {
+            let plan = study::finger::Plan::new(objects_or(&a.scenario), a.quick, &a.growth, &a.pad_height, &a.seeds);
+            let outcome = study::finger::run(&plan, &out, a.threads)?;
+            emit(&format!("{}\n", outcome.recommendation));
+            outcome.files
+        }
+        "hold" => {
+            if a.runs.is_empty() {
+                let (files, text) = study::hold::run_fast_creep(&first("scenarios/short-lift.toml"), &out)?;
+                emit(&text);
+                files
+            } else {
+                let runs: Vec<(String, PathBuf)> = a
+                    .runs
+                    .iter()
+                    .map(|r| match r.rsplit_once('=') {
+                        Some((name, dir)) => (name.to_string(), PathBuf::from(dir)),
+                        None => (r.clone(), PathBuf::from(r)),
+                    })
+                    .collect();
+                let scenario: tendril_run::scenario::PickPlaceScenario =
+                    tendril_config::load(&first("scenarios/short-lift.toml"), &[])?;
+                study::hold::draw(&runs, scenario.gripper.twine_max_deg.to_radians(), &out, "hold")?
+            }
+        }
+        "produce" => {
+            let plan = study::produce::Plan::new(&a.scenario, a.quick, &a.seeds)?;
+            let outcome = study::produce::run(&plan, &out, a.threads)?;
+            for w in &outcome.windows {
+                let why = if w.reason.is_empty() { String::new() } else { format!(": {}", w.reason) };
+                emit(&format!("{} ({}): window {}{why}\n", w.item, w.task, w.text()));
+            }
+            outcome.files
+        }
         "jitter" => {
             let seeds = if a.seeds.is_empty() { if a.quick { vec![1] } else { vec![1, 2] } } else { a.seeds.clone() };
             study::jitter::run(&first("scenarios/short-lift.toml"), &study::jitter::cases(a.quick), &seeds, &out)?
@@ -129,7 +204,19 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
     if a.quick && a.finest_step.is_some() {
         anyhow::bail!("--finest-step: the --quick plan has no finest setting (default, step/2 and links x2 only)");
     }
-    let plan = if a.quick { Plan::quick(dt, links) } else { Plan::full(dt, links, finest) };
+    // A produce item's study refines its flex as well (the same plan with or without --quick).
+    let produce = base.object.model()?.produce;
+    let plan = match produce {
+        Some(item) => {
+            let flex = study::convergence::FlexSetting {
+                count: base.produce.count.unwrap_or(item.count[0]),
+                dof: base.produce.dof.unwrap_or(item.dof),
+            };
+            study::convergence::Plan::produce(dt, links, flex)
+        }
+        None if a.quick => Plan::quick(dt, links),
+        None => Plan::full(dt, links, finest),
+    };
     let seeds = if a.seeds.is_empty() { vec![1, 2, 3] } else { a.seeds.clone() };
     let cases: Vec<Case> = scenarios
         .into_iter()

@@ -27,6 +27,9 @@ pub struct SweepArgs {
     /// scenario file and before `--set`.
     #[arg(long)]
     overlay: Option<PathBuf>,
+    /// Keep each run's directory under runs/<id>/ (trace.csv, summary.json) with its rosbag2 bag in bag/.
+    #[arg(long)]
+    bag: bool,
 }
 
 /// Most worker threads a sweep may ask for. Why: runs are CPU-bound and each holds its own
@@ -67,6 +70,7 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         threads: a.threads,
         shard: a.shard,
         resume: a.resume,
+        bag: a.bag,
     };
     // Ctrl-C, SIGTERM and SIGHUP: no new run starts; every finished row is kept whole.
     crate::signals::install_signal_handlers()?;

@@ -284,6 +284,6 @@ mod tests {
         let e = error(&GOOD.replace("short-lift:object.friction", "short-lift:object.frction"));
         assert!(e.contains("not a scenario key"), "{e}");
         let e = error("[parameters.\"finger.relaxed_fraction\"]\nmin = 0.01\nmax = 0.5\n");
-        assert!(e.contains("recordings") && e.contains("no [[targets]]"), "{e}");
+        assert!(e.contains("recordings") && e.contains("[[targets]]"), "{e}");
     }
 }

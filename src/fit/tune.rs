@@ -132,6 +132,10 @@ pub struct TuneScenario {
     pub table: toml::Table,
     /// Its grasp time \[s\] (the rise-time penalty of a run that never rises).
     pub grasp_s: f64,
+    /// Its object's class (the label the summary names it by), the row of `table.toml`.
+    pub object: String,
+    /// Its setpoint \[N\], which `table.toml` records with the tuned keys.
+    pub setpoint_n: f64,
 }
 
 /// A tune, loaded and checked.
@@ -229,7 +233,14 @@ pub fn load_tune(file: &Path, overlay: &Overlay) -> Result<Tune, ScenarioError> 
                 ("scenarios".into(), format!("two scenarios named `{name}`: each needs its own results folder")),
             ));
         }
-        scenarios.push(TuneScenario { file: path, name, table, grasp_s: scenario.task.grasp_s });
+        scenarios.push(TuneScenario {
+            file: path,
+            name,
+            table,
+            grasp_s: scenario.task.grasp_s,
+            object: scenario.object.label(),
+            setpoint_n: scenario.setpoint_n,
+        });
     }
     let disturbances: Vec<Vec<Override>> = if spec.disturbances.is_empty() {
         vec![Vec::new()]
@@ -326,9 +337,34 @@ fn evaluate(tune: &Tune, scenario: &TuneScenario, cases: &[Vec<Override>], value
     Evaluation { objective, failed, detail: serde_json::json!({ "runs": runs }) }
 }
 
+/// One object's row of `table.toml`: its setpoint (unless tuned) and the best values of the
+/// keys a table may hold (`setpoint_n`, `controller.*`), with the type that won.
+fn table_row(tune: &Tune, scenario: &TuneScenario, values: &[f64], t: Option<&str>) -> toml::Table {
+    let mut row = toml::Table::new();
+    row.insert("setpoint_n".into(), toml::Value::Float(scenario.setpoint_n));
+    for (p, &v) in tune.params.iter().zip(values) {
+        if p.key == "setpoint_n" || p.key.starts_with("controller.") {
+            // Six significant digits: the search's last bits (79.99999999999997) are no setting.
+            let value = match p.toml_value(v) {
+                toml::Value::Float(f) if f != 0.0 && f.is_finite() => {
+                    let scale = 10f64.powi(5 - f.abs().log10().floor() as i32);
+                    toml::Value::Float((f * scale).round() / scale)
+                }
+                other => other,
+            };
+            row.insert(p.key.clone(), value);
+        }
+    }
+    if let Some(t) = t {
+        row.insert("controller.type".into(), toml::Value::String(t.into()));
+    }
+    row
+}
+
 /// Runs every search of the tune into `out_dir/<scenario>/` (`out_dir/<scenario>/<type>/` with
 /// `controller_types`); writes each scenario's best as `out_dir/<scenario>/overlay.toml`, a
-/// landscape chart per search and `out_dir/tune.json`.
+/// landscape chart per search, `out_dir/tune.json`, and `out_dir/table.toml`, the per-object table
+/// a `[detector]` chooses settings from (each object's setpoint and best keys, by its class).
 pub fn run_tune(
     tune: &Tune,
     out_dir: &Path,
@@ -337,6 +373,7 @@ pub fn run_tune(
 ) -> anyhow::Result<(Vec<TuneResult>, Vec<PathBuf>)> {
     let mut results = Vec::new();
     let mut written = Vec::new();
+    let mut table = toml::Table::new();
     let types: Vec<Option<&str>> =
         if tune.types.is_empty() { vec![None] } else { tune.types.iter().map(|t| Some(t.as_str())).collect() };
     for scenario in &tune.scenarios {
@@ -433,7 +470,22 @@ pub fn run_tune(
                 super::write_text(&path, &text)?;
             }
             written.push(path);
+            table.insert(scenario.object.clone(), toml::Value::Table(table_row(tune, scenario, &values, t)));
         }
+    }
+    if !table.is_empty() {
+        let path = out_dir.join("table.toml");
+        let mut file = toml::Table::new();
+        file.insert("classes".into(), toml::Value::Table(table));
+        let text = format!(
+            "# tendril tune {}: each object's setpoint and best keys, by its class: the table a scenario's\n\
+             # [detector] chooses settings from (`table = \"{}\"`).\n{}",
+            tune.file.display(),
+            path.display(),
+            toml::to_string(&file)?
+        );
+        super::write_text(&path, &text)?;
+        written.push(path);
     }
     let json = out_dir.join("tune.json");
     super::write_text(&json, &(serde_json::to_string_pretty(&results)? + "\n"))?;

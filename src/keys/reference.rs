@@ -23,7 +23,9 @@ const SWITCHED_ON: &[&str] = &[
     "[controller]\ntype = \"slip_margin\"\n",
     "[disturbance.push]\nimpulse_n_s = 0.3\nphase = \"lift\"\n[disturbance.dropout]\nduration_s = 0.5\nphase = \"lift\"\n",
     "[object]\nname = \"crimper\"\nfriction = 1.0\nposition_m = [0.0, 0.0]\nmass_kg = 0.1\nyaw_deg = 0.0\n",
+    "[produce]\nmodulus_pa = 5e5\npoisson = 0.45\nbruise_pa = 1.5e5\ndetach_n = 6.0\ncount = 7\ndof = \"trilinear\"\n",
     "[array]\n[[array.pads]]\narc_m = 0.012\nlambda1_nm = 1520.0\nlambda2_nm = 1530.0\n",
+    "[detector]\ntable = \"object-table.toml\"\n",
 ];
 
 /// One key of the reference.

@@ -11,12 +11,25 @@
 //!   fluctuation, rise, overshoot, peak force.
 //! - [`jitter`]: the real path against the virtual devices under injected timing jitter, against
 //!   the twin (runs in real time, one at a time).
+//! - [`settle`]: grasp until settled against the paper's fixed grasp: cycle time and held runs.
+//! - [`detector`]: settings chosen by a detected class: what a wrong class costs, and held runs
+//!   against the detector's accuracy.
+//! - [`hold`]: a long grasp's grip and twine motor over time, the hold off and on.
+//! - [`finger`]: the finger's growth length and pad height against hold margin, contact area, peak
+//!   force and cycle time, and the size its numbers recommend.
+//! - [`produce`]: the produce items against Hertz between plates, and each item's window of
+//!   setpoints that holds or harvests it without bruising it.
 
 pub mod controllers;
 pub mod convergence;
+pub mod detector;
+pub mod finger;
 pub mod gain_map;
+pub mod hold;
 pub mod jitter;
 pub mod placement;
+pub mod produce;
+pub mod settle;
 pub mod speed_accuracy;
 pub mod stability;
 

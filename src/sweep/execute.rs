@@ -7,7 +7,7 @@ use super::{Shard, Sweep, SweepRun};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use tendril_run::execute::{ModelCache, run_on_twin};
+use tendril_run::execute::{Driver, ModelCache, run_on_twin, run_on_twin_with};
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_run::summary::RunSummary;
 
@@ -22,7 +22,12 @@ pub struct SweepOptions {
     pub shard: Option<Shard>,
     /// Skip runs already in the results file.
     pub resume: bool,
+    /// Keep each run's directory, `runs/<id>/` (trace, summary and its rosbag2 bag in `bag/`).
+    pub bag: bool,
 }
+
+/// The folder under a sweep's output where `--bag` keeps each run's directory.
+pub const RUNS_DIR: &str = "runs";
 
 /// What a sweep did.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,13 +104,22 @@ fn list_sets(sweep: &Sweep, run: &SweepRun, key: &str) -> bool {
     run.list_index.is_some_and(|i| sweep.list_keys.get(i).is_some_and(|keys| keys.iter().any(|k| k == key)))
 }
 
-fn execute_one(sweep: &Sweep, run: &SweepRun, models: &ModelCache) -> RunSummary {
+fn execute_one(sweep: &Sweep, run: &SweepRun, models: &ModelCache, options: &SweepOptions) -> RunSummary {
     let name = run.scenario.file_stem().map_or("?".into(), |s| s.to_string_lossy().to_string());
     let scenario = match sweep.overlay.load_scenario::<PickPlaceScenario>(&run.scenario, &run.overrides) {
         Ok(s) => s,
         Err(e) => return RunSummary::failed_to_start(&name, e.to_string()),
     };
-    match run_on_twin(&scenario, models, None) {
+    let result = if options.bag {
+        // A directory left by an attempt that has no row (a sweep stopped mid-run) is not a
+        // result: --resume runs it again from scratch.
+        let dir = options.out_dir.join(RUNS_DIR).join(run.id.to_string());
+        let _ = std::fs::remove_dir_all(&dir);
+        run_on_twin_with(&scenario, models, Some(&dir), Driver { bag: true, ..Driver::default() })
+    } else {
+        run_on_twin(&scenario, models, None)
+    };
+    match result {
         Ok((summary, _)) => summary,
         Err(e) => RunSummary::failed_to_start(&scenario.name, format!("{e:#}")),
     }
@@ -142,7 +156,7 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
                 {
                     return Ok(None);
                 }
-                let summary = execute_one(sweep, run, &models);
+                let summary = execute_one(sweep, run, &models, options);
                 // A run cut short by an operator stop is not done: no row, so --resume runs it.
                 if tendril_cell::interrupt::requested().is_some() {
                     return Ok(None);

@@ -142,9 +142,8 @@ impl LiveCell {
     /// Records how the task ended, for the panel.
     pub fn finished(&mut self, outcome: Outcome, error: Option<&str>) {
         let text = match (outcome, error) {
-            (Outcome::Held, _) => "held".to_string(),
-            (Outcome::Dropped, _) => "dropped".to_string(),
             (Outcome::Error, e) => format!("error: {}", e.unwrap_or("unknown")),
+            (other, _) => other.name().to_string(),
         };
         self.status.borrow_mut().finished = Some(text);
     }
@@ -452,6 +451,7 @@ mod tests {
             grip_force_n: 2.0,
             tool_load_n: 3.4,
             array: Default::default(),
+            produce: None,
         }
     }
 

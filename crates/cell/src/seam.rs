@@ -82,6 +82,41 @@ pub struct GroundTruth {
     pub in_contact: bool,
     /// Where the object's grip point sits in the hand's frame \[m\]; its change is slip.
     pub object_in_hand_m: [f64; 3],
+    /// A produce item's damage and stem (`None` for a rigid object).
+    pub produce: Option<ProduceTruth>,
+}
+
+/// A produce item's contact pressure and stem, as only a simulation knows them. The run's figures
+/// accumulate over every physics step, the last step's are what a trace samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+pub struct ProduceTruth {
+    /// The last step's largest peak contact pressure on the item \[Pa\].
+    pub pressure_pa: f64,
+    /// The last step's area above the bruise threshold \[m²\].
+    pub area_above_m2: f64,
+    /// The run's largest peak contact pressure \[Pa\].
+    pub peak_pa: f64,
+    /// What pressed there (`pad_bump`, `pad_casing`, `strip`, `palm`, `other`; empty: nothing).
+    pub peak_at: &'static str,
+    /// The run's largest area above the bruise threshold at one step \[m²\].
+    pub max_area_above_m2: f64,
+    /// Time with some contact above the bruise threshold \[s\].
+    pub time_above_s: f64,
+    /// The item's bruise threshold \[Pa\].
+    pub bruise_pa: f64,
+    /// Whether the item started on its plant (a harvest).
+    pub harvest: bool,
+    /// The stem's tension at the last step \[N\] (0 without a stem, or once it let go).
+    pub stem_tension_n: f64,
+    /// The stem's largest tension \[N\].
+    pub max_stem_tension_n: f64,
+    /// The force at which the stem lets go \[N\] (`None`: the item has none).
+    pub detach_n: Option<f64>,
+    /// Cell time the stem let go \[s\] (`None`: still attached, or no stem).
+    pub detached_s: Option<f64>,
+    /// Normal force on the sensor pad's bump alone \[N\] (the sensor's input is the bump's and
+    /// the casing's together).
+    pub pad_bump_force_n: f64,
 }
 
 /// Percentiles of a timing over a run \[ms\].

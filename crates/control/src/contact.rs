@@ -104,6 +104,11 @@ impl ContactDetector {
         self.rise_n.max(Z * self.noise_n() / (self.window_ticks() as f64).sqrt())
     }
 
+    /// Forgets the readings of an earlier close, for a new one (a long grasp's re-wrap).
+    pub fn restart(&mut self) {
+        self.window.clear();
+    }
+
     /// Takes this tick's rise of the estimate above the unloaded reading \[N\]; true once the mean
     /// of the last [`Self::window_ticks`] rises reaches [`Self::threshold_n`].
     pub fn touched(&mut self, rise_n: f64) -> bool {

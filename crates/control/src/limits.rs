@@ -11,6 +11,9 @@
 //! - Force ceiling: when the force estimated from the latest wavelengths (eq. 8, tared on the
 //!   first sample after activation: the finger is retracted then) exceeds the ceiling, the twine
 //!   motor may not wind further than its measured position (stop tightening; releasing is allowed).
+//! - Twine travel: the twine motor is never sent past the end of its travel (or below the straight
+//!   finger). The task keeps its commands inside it and stops the controller's integral there
+//!   ([`crate::task`]); this is the backstop for a caller that does not.
 
 use crate::task::Phase;
 use tendril_cell::{ARM_JOINTS, Cell, CellCommand, CellError, CellState, DeviceTiming, GroundTruth, Lifecycle};
@@ -27,17 +30,24 @@ pub struct SafetyLimits {
     pub max_force_n: f64,
     /// Calibration for the ceiling's force estimate.
     pub calibration: ForceCalibration,
+    /// The twine motor's travel \[rad\] from the straight finger (`gripper.twine_max_deg`).
+    pub twine_max_rad: f64,
 }
 
 impl SafetyLimits {
-    /// Limits 20 % above the task's own (so a planned move is never clipped) and a ceiling at 90 %
-    /// of the sensor's range (4.22 N for the paper's 4.69 N).
-    pub fn for_task(limits: &crate::trajectory::JointLimits, calibration: &ForceCalibration) -> SafetyLimits {
+    /// Limits 20 % above the task's own (so a planned move is never clipped), a ceiling at 90 %
+    /// of the sensor's range (4.22 N for the paper's 4.69 N) and the gripper's twine travel.
+    pub fn for_task(
+        limits: &crate::trajectory::JointLimits,
+        calibration: &ForceCalibration,
+        gripper: &tendril_cell::gripper::GripperConfig,
+    ) -> SafetyLimits {
         SafetyLimits {
             max_speed_rad_s: 1.2 * limits.max_speed_deg_s.to_radians(),
             max_accel_rad_s2: 1.2 * limits.max_accel_deg_s2.to_radians(),
             max_force_n: 0.9 * calibration.range_n,
             calibration: calibration.clone(),
+            twine_max_rad: gripper.twine_max_deg.to_radians(),
         }
     }
 }
@@ -56,6 +66,8 @@ pub struct LimitedCell<C: Cell> {
     over_force: bool,
     /// Commands changed by the limits so far (speed/acceleration, force).
     pub interventions: (u64, u64),
+    /// Twine commands held to the motor's travel so far.
+    pub travel_interventions: u64,
 }
 
 impl<C: Cell> LimitedCell<C> {
@@ -73,6 +85,7 @@ impl<C: Cell> LimitedCell<C> {
             last_speed: [0.0; ARM_JOINTS],
             over_force: false,
             interventions: (0, 0),
+            travel_interventions: 0,
         }
     }
 
@@ -144,6 +157,11 @@ impl<C: Cell> Cell for LimitedCell<C> {
         let measured = self.last_state.map(|s| s.arm_q).unwrap_or(command.arm_q);
         let mut c = *command;
         c.arm_q = self.limit_arm(command.arm_q, measured);
+        let within = c.twine_motor_rad.clamp(0.0, self.limits.twine_max_rad);
+        if within != c.twine_motor_rad {
+            c.twine_motor_rad = within;
+            self.travel_interventions += 1;
+        }
         if self.over_force
             && let Some(s) = self.last_state
             && c.twine_motor_rad > s.twine_motor_rad
@@ -232,6 +250,7 @@ mod tests {
             max_accel_rad_s2: 10.0,
             max_force_n: 2.0,
             calibration: ForceCalibration::default(),
+            twine_max_rad: 3.0,
         };
         LimitedCell::new(Recorder { t: 0.0, periods: vec![0.01], reads: 0, w, twine: 1.0, written: Vec::new() }, limits)
     }
@@ -293,5 +312,17 @@ mod tests {
         c.write(&command(0.0, 0.5)).unwrap();
         assert_eq!(c.inner().written.last().unwrap().twine_motor_rad, 0.5, "loosening is allowed");
         assert_eq!(c.interventions.1, 1);
+    }
+
+    #[test]
+    fn the_twine_is_never_sent_past_its_travel() {
+        let mut c = limited();
+        c.activate().unwrap();
+        c.read().unwrap();
+        for (asked, sent) in [(2.5, 2.5), (3.5, 3.0), (-0.2, 0.0)] {
+            c.write(&command(0.0, asked)).unwrap();
+            assert_eq!(c.inner().written.last().unwrap().twine_motor_rad, sent, "asked {asked} rad");
+        }
+        assert_eq!(c.travel_interventions, 2);
     }
 }

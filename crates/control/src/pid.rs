@@ -72,6 +72,11 @@ impl Pid {
         &self.config
     }
 
+    /// The integral of the error so far \[N·s\] (what anti-windup keeps from growing).
+    pub fn integral(&self) -> f64 {
+        self.integral
+    }
+
     /// Clears the integral and derivative memory (used when the controller is switched on).
     pub fn reset(&mut self) {
         self.integral = 0.0;

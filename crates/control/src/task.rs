@@ -6,6 +6,8 @@
 
 use super::contact::ContactDetector;
 use super::controller::{ArmMotion, ControlContext, ForceController, MoveOutlook};
+use super::hold::{Grip, HoldConfig};
+use super::settle::{GraspEnd, SettleConfig, SettleWatch};
 use super::trajectory::{JointLimits, JointMove};
 use serde::{Deserialize, Serialize};
 use tendril_cell::gripper::{GripperConfig, MX106_MAX_SPEED_DEG_S};
@@ -48,7 +50,8 @@ pub struct TaskConfig {
     pub wrap_contact_n: f64,
     /// Longest guarded close \[s\]; past it the grasp starts anyway (and will likely fail).
     pub wrap_timeout_s: f64,
-    /// Grasp period under force control before the arm moves \[s\]. Paper Sec. V-B: 15 s.
+    /// Grasp period under force control before the arm moves \[s\]. Paper Sec. V-B: 15 s. With
+    /// `settled_grasp.enabled` the grasp ends once settled instead.
     pub grasp_s: f64,
     /// Shortest lift duration \[s\]. The paper reports the crimper dropping "during the upward
     /// motion" at ≈ 10 s after the arm started: the lift lasts 11 s.
@@ -68,6 +71,10 @@ pub struct TaskConfig {
     /// 15 °/s² by default: the arm then moves as hard as the limits allow, and the phase
     /// durations are the moves' (a few seconds each) instead of the paper's drop times.
     pub minimum_durations: bool,
+    /// Grasp until settled instead of for `grasp_s` (off by default: the paper's fixed grasp).
+    pub settled_grasp: SettleConfig,
+    /// How a long grasp holds: it lets go of the object waiting on the table and re-wraps it.
+    pub hold: HoldConfig,
 }
 
 impl Default for TaskConfig {
@@ -90,6 +97,8 @@ impl Default for TaskConfig {
             release_s: 2.0,
             limits: JointLimits::default(),
             minimum_durations: true,
+            settled_grasp: SettleConfig::default(),
+            hold: HoldConfig::default(),
         }
     }
 }
@@ -131,6 +140,8 @@ impl Validate for TaskConfig {
             at.in_range(name, value, 0.0, MAX_PHASE_S);
         }
         at.section("limits", &self.limits);
+        at.section("settled_grasp", &self.settled_grasp);
+        at.section("hold", &self.hold);
         // Slow joint limits stretch the moves: each must still fit in a phase.
         let moves = [
             (&self.home_deg, &self.lift_deg),
@@ -193,6 +204,39 @@ pub struct TaskSequencer {
     contact: ContactDetector,
     /// The lift, planned when the grasp starts (what the controller is told is ahead).
     next_move: Option<JointMove>,
+    /// Whether the estimate has settled, with `task.settled_grasp`.
+    settle: SettleWatch,
+    /// What the grasp came to: how long it lasted and how it ended, once it has.
+    grasp: Option<GraspOutcome>,
+    /// Where a long grasp stands with its object (`task.hold`), the twine it let go at \[°\] and
+    /// when its re-wrap started.
+    grip: Grip,
+    released_twine_deg: f64,
+    rewrap_start_s: f64,
+    /// How often the grasp let go, and how far the twine went.
+    hold: HoldRecord,
+}
+
+/// How the grasp ended and how long it lasted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GraspOutcome {
+    /// How it ended: [`GraspEnd::Settled`] also for the paper's fixed grasp run to its end.
+    pub end: GraspEnd,
+    /// Its length \[s\].
+    pub duration_s: f64,
+}
+
+/// What the run's long hold did (`task.hold`) and how far the twine went.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HoldRecord {
+    /// Times the grasp let go of the waiting object (and wrapped it again).
+    pub releases: u32,
+    /// Cell time the twine first reached the end of its travel \[s\], if it did.
+    pub travel_end_s: Option<f64>,
+    /// The largest twine while the arm was still (the grasp), as a fraction of its travel [-].
+    pub max_grasp_travel: f64,
+    /// The largest twine over the run, as a fraction of its travel [-].
+    pub max_travel: f64,
 }
 
 fn radians(deg: &[f64; ARM_JOINTS]) -> [f64; ARM_JOINTS] {
@@ -227,7 +271,23 @@ impl TaskSequencer {
             unloaded_n: 0.0,
             contact,
             next_move: None,
+            settle: SettleWatch::default(),
+            grasp: None,
+            grip: Grip::Holding,
+            released_twine_deg: 0.0,
+            rewrap_start_s: 0.0,
+            hold: HoldRecord::default(),
         }
+    }
+
+    /// How the grasp ended and how long it lasted, once it has.
+    pub fn grasp_outcome(&self) -> Option<GraspOutcome> {
+        self.grasp
+    }
+
+    /// What the long hold did and how far the twine went.
+    pub fn hold_record(&self) -> HoldRecord {
+        self.hold
     }
 
     /// Sets what the estimator reads with nothing on the sensor \[N\] (the estimate at the tare);
@@ -297,6 +357,8 @@ impl TaskSequencer {
     fn held_pose(&self) -> [f64; ARM_JOINTS] {
         match self.phase {
             Phase::Home | Phase::Grow | Phase::Wrap | Phase::Grasp => radians(&self.task.home_deg),
+            // A grasp that failed lets go where it stood.
+            _ if self.motion_start_s.is_none() => radians(&self.task.home_deg),
             _ => radians(&self.task.place_deg),
         }
     }
@@ -317,7 +379,7 @@ impl TaskSequencer {
     /// What lies ahead of the arm `elapsed` seconds into the current phase.
     fn outlook(&self, elapsed: f64) -> MoveOutlook {
         let (time_to_motion_s, plan) = match (self.phase, &self.arm_move, &self.next_move) {
-            (Phase::Grasp, _, Some(next)) => ((self.task.grasp_s - elapsed).max(0.0), next),
+            (Phase::Grasp, _, Some(next)) => (self.grasp_remaining_s(elapsed), next),
             (p, Some(current), _) if p.arm_moving() => (0.0, current),
             _ => return MoveOutlook::default(),
         };
@@ -325,6 +387,27 @@ impl TaskSequencer {
             time_to_motion_s,
             peak_accel_rad_s2: plan.peak_accel_rad_s2(),
             peak_speed_rad_s: plan.peak_speed_rad_s(),
+        }
+    }
+
+    /// Time left in the grasp `elapsed` seconds into it \[s\]: to its fixed end, or with
+    /// `settled_grasp` the soonest it can settle.
+    fn grasp_remaining_s(&self, elapsed: f64) -> f64 {
+        let s = &self.task.settled_grasp;
+        if s.enabled {
+            self.settle.time_to_settled_s(s, self.phase_start_s + elapsed)
+        } else {
+            (self.task.grasp_s - elapsed).max(0.0)
+        }
+    }
+
+    /// How the grasp ends this tick, if it does.
+    fn grasp_end(&mut self, now: f64, elapsed: f64, force_n: f64) -> Option<GraspEnd> {
+        let s = self.task.settled_grasp;
+        if s.enabled {
+            self.settle.update(&s, now, elapsed, force_n, self.setpoint_n)
+        } else {
+            (elapsed >= self.task.grasp_s).then_some(GraspEnd::Settled)
         }
     }
 
@@ -346,7 +429,14 @@ impl TaskSequencer {
             Phase::Home if elapsed >= self.task.settle_s => Some(Phase::Grow),
             Phase::Grow if self.growth_m >= self.task.growth_m => Some(Phase::Wrap),
             Phase::Wrap if touched || elapsed >= self.task.wrap_timeout_s => Some(Phase::Grasp),
-            Phase::Grasp if elapsed >= self.task.grasp_s => Some(Phase::Lift),
+            Phase::Grasp => self.grasp_end(now, elapsed, force_n).map(|end| {
+                self.grasp = Some(GraspOutcome { end, duration_s: elapsed });
+                match end {
+                    GraspEnd::Settled => Phase::Lift,
+                    // Fail safely: let go where the object stands, never lift it.
+                    GraspEnd::TimedOut => Phase::Release,
+                }
+            }),
             Phase::Lift | Phase::Transfer | Phase::Lower
                 if self.arm_move.as_ref().is_some_and(|m| elapsed >= m.duration_s()) =>
             {
@@ -374,18 +464,19 @@ impl TaskSequencer {
             None => self.held_pose(),
         };
 
+        self.update_grip(now, elapsed, force_n);
         let mut controller_output = 0.0;
         let controller_on = match self.phase {
-            Phase::Grasp => true,
+            Phase::Grasp => self.grip == Grip::Holding,
             p if p.arm_moving() => self.feedback_while_moving,
             _ => false,
         };
         match self.phase {
             Phase::Grow => self.growth_m = (self.growth_m + self.task.growth_speed_m_s * dt_s).min(self.task.growth_m),
             Phase::Wrap => self.twine_deg += self.task.wrap_speed_deg_s * dt_s,
-            Phase::Release => {
-                self.twine_deg = (self.twine_deg - self.controller.max_speed_deg_s() * dt_s).max(0.0);
-            }
+            Phase::Release => self.unwind(dt_s),
+            Phase::Grasp if self.grip == Grip::Released => self.unwind(dt_s),
+            Phase::Grasp if self.grip == Grip::Rewrapping => self.twine_deg += self.task.wrap_speed_deg_s * dt_s,
             _ => {}
         }
         let setpoint_n = match action {
@@ -414,6 +505,7 @@ impl TaskSequencer {
             self.twine_deg += controller_output * dt_s;
         }
         self.twine_deg = self.twine_deg.clamp(0.0, self.gripper.twine_max_deg);
+        self.record_twine(now);
 
         TickDecision {
             command: CellCommand {
@@ -425,6 +517,62 @@ impl TaskSequencer {
             controller_output_deg_s: controller_output,
             controller_on,
             setpoint_n,
+        }
+    }
+}
+
+impl TaskSequencer {
+    /// A long grasp's release and re-wrap (`task.hold`; not with a settled grasp, which ends as
+    /// soon as it can): let go once it has lasted `release_after_s` or used `release_at_travel`,
+    /// close again in time to touch near the twine it let go at and leave `rewrap_settle_s` before
+    /// the move, hold once the close touches (or after `task.wrap_timeout_s`, as the first close).
+    fn update_grip(&mut self, now: f64, elapsed: f64, force_n: f64) {
+        if self.phase != Phase::Grasp || self.task.settled_grasp.enabled {
+            self.grip = Grip::Holding;
+            return;
+        }
+        let hold = self.task.hold;
+        let remaining = self.grasp_remaining_s(elapsed);
+        let travel_used = self.twine_deg / self.gripper.twine_max_deg;
+        let close_s = |twine_deg: f64| twine_deg / self.task.wrap_speed_deg_s;
+        self.grip = match self.grip {
+            Grip::Holding if hold.release(elapsed, remaining, travel_used, close_s(self.twine_deg)) => {
+                self.hold.releases += 1;
+                self.released_twine_deg = self.twine_deg;
+                Grip::Released
+            }
+            Grip::Released if hold.rewrap(remaining, close_s(self.released_twine_deg)) => {
+                self.contact.restart();
+                self.rewrap_start_s = now;
+                Grip::Rewrapping
+            }
+            Grip::Rewrapping
+                if self.contact.touched(force_n - self.unloaded_n)
+                    || now - self.rewrap_start_s >= self.task.wrap_timeout_s =>
+            {
+                self.controller.reset();
+                Grip::Holding
+            }
+            grip => grip,
+        };
+    }
+
+    /// Unwinds the twine towards the straight finger at the controller's speed limit.
+    fn unwind(&mut self, dt_s: f64) {
+        self.twine_deg = (self.twine_deg - self.controller.max_speed_deg_s() * dt_s).max(0.0);
+    }
+
+    /// Keeps the twine's record: its largest value, in the grasp and over the run, and when it
+    /// first reached the travel's end.
+    fn record_twine(&mut self, now: f64) {
+        let h = &mut self.hold;
+        let used = self.twine_deg / self.gripper.twine_max_deg;
+        h.max_travel = h.max_travel.max(used);
+        if self.phase == Phase::Grasp {
+            h.max_grasp_travel = h.max_grasp_travel.max(used);
+        }
+        if self.twine_deg >= self.gripper.twine_max_deg && h.travel_end_s.is_none() {
+            h.travel_end_s = Some(now);
         }
     }
 }
@@ -486,6 +634,166 @@ mod tests {
             }
         }
         (phases, trace, arm)
+    }
+
+    /// A toy plant whose creep grows with the force it carries (as the strip's does: its rate is
+    /// the creeping branch's tension over the dashpot): force = 0.02 N/° past first contact at 60°
+    /// less the creep, which grows by `creep_per_s` × force per second. Runs the task with `task`
+    /// and the paper's PID (setpoint 1 N) and returns the sequencer at the end with every tick's
+    /// (time, phase, force, twine °, setpoint).
+    #[allow(clippy::type_complexity)]
+    fn run_creeping(
+        task: TaskConfig,
+        creep_per_s: f64,
+        ticks: usize,
+    ) -> (TaskSequencer, Vec<(f64, Phase, f64, f64, f64)>) {
+        let mut seq =
+            TaskSequencer::new(task, GripperConfig::default(), Box::new(Pid::new(PidConfig::default())), 1.0, true);
+        let dt = 0.01;
+        let (mut twine_deg, mut creep, mut arm_q) = (0.0_f64, 0.0_f64, [0.0; ARM_JOINTS]);
+        let mut trace = vec![];
+        for i in 0..ticks {
+            let t = i as f64 * dt;
+            let force = (0.02 * (twine_deg - 60.0) - creep).max(0.0);
+            let state = CellState {
+                time_s: t,
+                arm_q,
+                growth_motor_rad: 0.0,
+                twine_motor_rad: twine_deg.to_radians(),
+                wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+                array: Default::default(),
+                tool_load_n: None,
+            };
+            let d = seq.update(&state, force, dt);
+            trace.push((t, d.phase, force, twine_deg, d.setpoint_n));
+            twine_deg = d.command.twine_motor_rad.to_degrees();
+            arm_q = d.command.arm_q;
+            creep += creep_per_s * force * dt;
+            if d.phase == Phase::Done {
+                break;
+            }
+        }
+        (seq, trace)
+    }
+
+    #[test]
+    fn a_settled_grasp_lifts_once_in_the_band_for_the_dwell() {
+        let settled = SettleConfig { enabled: true, band_pct: 5.0, dwell_s: 1.0, timeout_s: 15.0 };
+        let task = TaskConfig { settled_grasp: settled, ..TaskConfig::default() };
+        let (seq, trace) = run_creeping(task, 0.0, 10_000);
+        let grasp: Vec<_> = trace.iter().filter(|r| r.1 == Phase::Grasp).collect();
+        let outcome = seq.grasp_outcome().unwrap();
+        assert_eq!(outcome.end, GraspEnd::Settled);
+        // The toy's loop time constant is 1 / (Kp 20 × 0.02 N/°) = 2.5 s: 95 % after 7.5 s, plus the dwell.
+        assert!(outcome.duration_s < 12.0, "settled before the paper's 15 s: {outcome:?}");
+        // The last dwell's ticks were all in the band, and the lift followed.
+        let dwell = grasp.iter().rev().take(100);
+        assert!(dwell.clone().all(|r| (r.2 - 1.0).abs() <= 0.05), "left the band in the dwell");
+        let phases: Vec<Phase> = trace.iter().map(|r| r.1).collect();
+        assert!(phases.contains(&Phase::Lift) && phases.last() == Some(&Phase::Done));
+    }
+
+    #[test]
+    fn a_grasp_that_never_settles_lets_go_at_home_without_lifting() {
+        // A 0.1 % band is below what this loop reaches at a creep of 1 % of the force per second.
+        let settled = SettleConfig { enabled: true, band_pct: 0.1, dwell_s: 2.0, timeout_s: 8.0 };
+        let task = TaskConfig { settled_grasp: settled, ..TaskConfig::default() };
+        let (seq, trace) = run_creeping(task.clone(), 0.2, 10_000);
+        assert_eq!(seq.grasp_outcome().map(|g| g.end), Some(GraspEnd::TimedOut));
+        assert!((seq.grasp_outcome().unwrap().duration_s - 8.0).abs() < 0.011);
+        let phases: Vec<Phase> = trace.iter().map(|r| r.1).collect();
+        assert!(!phases.iter().any(|p| p.arm_moving()), "the arm must not move after a failed grasp");
+        assert_eq!(phases.last(), Some(&Phase::Done));
+        assert_eq!(seq.motion_start_s(), None);
+        // Released: the twine back at zero at the end.
+        assert_eq!(trace.last().unwrap().3, 0.0);
+    }
+
+    #[test]
+    fn the_integral_stops_growing_at_the_twine_travels_end() {
+        // A spy around the paper's PID: each tick's blocked flag and the integral after it.
+        #[derive(Debug)]
+        struct Watched(Pid, std::sync::Arc<std::sync::Mutex<Vec<(bool, f64)>>>);
+        impl ForceController for Watched {
+            fn update(&mut self, ctx: &ControlContext) -> f64 {
+                let u = self.0.update(ctx.setpoint_n, ctx.force_n, ctx.dt_s, ctx.blocked);
+                self.1.lock().unwrap().push((ctx.blocked, self.0.integral()));
+                u
+            }
+            fn reset(&mut self) {
+                self.0.reset();
+            }
+            fn max_speed_deg_s(&self) -> f64 {
+                90.0
+            }
+        }
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(vec![]));
+        let task = TaskConfig {
+            grasp_s: 300.0,
+            hold: HoldConfig { enabled: false, ..HoldConfig::default() },
+            ..Default::default()
+        };
+        let pid = Watched(Pid::new(PidConfig::default()), seen.clone());
+        let mut seq = TaskSequencer::new(task, GripperConfig::default(), Box::new(pid), 1.0, true);
+        // A creep of 5 % of the force per second runs the 211° travel out within the grasp.
+        let (dt, mut twine_deg, mut creep) = (0.01, 0.0_f64, 0.0);
+        for i in 0..20_000 {
+            let force = (0.02 * (twine_deg - 60.0) - creep).max(0.0);
+            let state = CellState {
+                time_s: i as f64 * dt,
+                arm_q: [0.0; ARM_JOINTS],
+                growth_motor_rad: 0.0,
+                twine_motor_rad: twine_deg.to_radians(),
+                wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+                array: Default::default(),
+                tool_load_n: None,
+            };
+            let d = seq.update(&state, force, dt);
+            twine_deg = d.command.twine_motor_rad.to_degrees();
+            creep += 0.05 * force * dt;
+        }
+        let end = seq.hold_record().travel_end_s.expect("the travel ran out");
+        assert!(end < 150.0, "{end}");
+        let seen = seen.lock().unwrap();
+        let at_end: Vec<&(bool, f64)> = seen.iter().skip_while(|(blocked, _)| !blocked).collect();
+        assert!(at_end.len() > 1000, "blocked for {} ticks", at_end.len());
+        let first = at_end[0].1;
+        assert!(
+            at_end.iter().all(|(blocked, integral)| *blocked && *integral == first),
+            "the integral moved while blocked"
+        );
+    }
+
+    #[test]
+    fn a_long_grasp_lets_go_and_rewraps_where_a_held_one_runs_out_of_travel() {
+        // 200 s of grasp on a plant that creeps by 2 % of its force per second: held at the
+        // setpoint the twine reaches its travel's end (60° + 5 N / 0.02 N/°). Let go at 30 s, the
+        // creep stops where it was (0.6 N), and the re-wrap 10 s before the move needs 60° +
+        // 1.6 N / 0.02 N/° = 140°: the travel is not used up, and the grip is back at the setpoint
+        // when the arm moves. (The toy's loop, time constant 2.5 s, is three to five times slower
+        // than the twin's: the re-wrap leaves it 8 s instead of 5 to rise after its close.)
+        let long = |hold: HoldConfig| TaskConfig { grasp_s: 200.0, hold, ..TaskConfig::default() };
+        let (held, _) = run_creeping(long(HoldConfig { enabled: false, ..HoldConfig::default() }), 0.02, 40_000);
+        assert!(held.hold_record().travel_end_s.is_some());
+        let hold = HoldConfig { rewrap_settle_s: 8.0, ..HoldConfig::default() };
+        let (released, trace) = run_creeping(long(hold), 0.02, 40_000);
+        let record = released.hold_record();
+        assert_eq!(record.releases, 1);
+        assert_eq!(record.travel_end_s, None, "{record:?}");
+        assert!(record.max_grasp_travel < 0.8, "{record:?}");
+        let lift_start = trace.iter().find(|r| r.1 == Phase::Lift).unwrap();
+        assert!((lift_start.2 - 1.0).abs() < 0.1, "force at the lift {}", lift_start.2);
+        // Unwound to the straight finger from 30 s into the grasp to the re-wrap, which starts the
+        // close from the twine let go at (about 138° at 15 °/s, 9 s) and 8 s before the lift.
+        let at = |t: f64| trace.iter().find(|r| r.0 >= t).unwrap();
+        let start = grasp_start(&trace);
+        assert_eq!(at(start + 40.0).3, 0.0);
+        assert_eq!(at(lift_start.0 - 17.5).3, 0.0);
+        assert!(at(lift_start.0 - 1.0).3 > 130.0);
+    }
+
+    fn grasp_start(trace: &[(f64, Phase, f64, f64, f64)]) -> f64 {
+        trace.iter().find(|r| r.1 == Phase::Grasp).unwrap().0
     }
 
     #[test]

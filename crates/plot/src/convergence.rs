@@ -46,6 +46,16 @@ pub struct ConvergenceRow {
     pub sim_s_per_wall_s: f64,
     /// The run's error, if any.
     pub error: Option<String>,
+    /// A produce item's flex grid, points per axis (absent for a rigid object).
+    pub grid: Option<u32>,
+    /// A produce item's flex degrees of freedom (`trilinear`, `quadratic`).
+    pub dof: Option<String>,
+    /// A produce item's largest peak contact pressure \[kPa\].
+    pub peak_pressure_kpa: Option<f64>,
+    /// A harvest's end (`harvested`, `stayed`, `slipped`, `dropped`).
+    pub harvest: Option<String>,
+    /// A harvest's largest stem tension, the pull the grip reached \[N\].
+    pub max_stem_tension_n: Option<f64>,
 }
 
 fn opt(v: Option<f64>) -> String {
@@ -53,8 +63,9 @@ fn opt(v: Option<f64>) -> String {
 }
 
 impl ConvergenceRow {
-    /// The CSV header, in the order of [`ConvergenceRow::cells`].
-    pub const HEADER: [&'static str; 16] = [
+    /// The CSV header, in the order of [`ConvergenceRow::cells`]; the last five are a produce
+    /// item's, optional when read.
+    pub const HEADER: [&'static str; 21] = [
         "backend",
         "case",
         "object",
@@ -71,7 +82,15 @@ impl ConvergenceRow {
         "force_rmse_vs_finest_n",
         "sim_s_per_wall_s",
         "error",
+        "produce_grid",
+        "produce_dof",
+        "peak_pressure_kpa",
+        "harvest",
+        "max_stem_tension_n",
     ];
+
+    /// Columns every `convergence.csv` has (the produce ones came later).
+    const REQUIRED: usize = 16;
 
     /// The row's CSV cells.
     pub fn cells(&self) -> Vec<String> {
@@ -92,6 +111,11 @@ impl ConvergenceRow {
             opt(self.force_rmse_vs_finest_n),
             self.sim_s_per_wall_s.to_string(),
             self.error.clone().unwrap_or_default(),
+            self.grid.map_or_else(String::new, |g| g.to_string()),
+            self.dof.clone().unwrap_or_default(),
+            opt(self.peak_pressure_kpa),
+            self.harvest.clone().unwrap_or_default(),
+            opt(self.max_stem_tension_n),
         ]
     }
 }
@@ -99,7 +123,10 @@ impl ConvergenceRow {
 /// Reads `convergence.csv`.
 pub fn read(path: &Path) -> Result<Vec<ConvergenceRow>, PlotError> {
     let t = Table::read(path)?;
-    let c: Vec<usize> = ConvergenceRow::HEADER.iter().map(|h| t.column(h)).collect::<Result<_, _>>()?;
+    let c: Vec<usize> =
+        ConvergenceRow::HEADER[..ConvergenceRow::REQUIRED].iter().map(|h| t.column(h)).collect::<Result<_, _>>()?;
+    let extra: Vec<Option<usize>> =
+        ConvergenceRow::HEADER[ConvergenceRow::REQUIRED..].iter().map(|h| t.optional_column(h)).collect();
     let rows = t
         .iter()
         .map(|r| {
@@ -123,6 +150,11 @@ pub fn read(path: &Path) -> Result<Vec<ConvergenceRow>, PlotError> {
                 force_rmse_vs_finest_n: r.opt_f64(c[13])?,
                 sim_s_per_wall_s: r.f64(c[14])?,
                 error: nonempty(15),
+                grid: extra[0].and_then(|i| r.text(i).parse().ok()),
+                dof: extra[1].map(|i| r.text(i).to_string()).filter(|s| !s.is_empty()),
+                peak_pressure_kpa: extra[2].map(|i| r.opt_f64(i)).transpose()?.flatten(),
+                harvest: extra[3].map(|i| r.text(i).to_string()).filter(|s| !s.is_empty()),
+                max_stem_tension_n: extra[4].map(|i| r.opt_f64(i)).transpose()?.flatten(),
             })
         })
         .collect::<Result<Vec<_>, PlotError>>()?;
@@ -167,6 +199,9 @@ impl Convergence {
                     .rows
                     .iter()
                     .filter(|r| r.case == case)
+                    // A produce item's grid and degrees of freedom have no axis here: only the
+                    // default's are drawn (the study's table holds the others).
+                    .filter(|r| r.grid == d.grid && r.dof == d.dof)
                     .filter(|r| if links_axis { r.timestep_s == d.timestep_s } else { r.segments == d.segments })
                     .map(|r| (refinement(links_axis, d, r), r))
                     .collect();

@@ -1,10 +1,10 @@
 //! A run's trace as columns (what `tendril.Run.trace` turns into numpy arrays) and one tick as a
 //! dict: the columns of `trace.csv`, in its order, at full precision (the file rounds to 3-5
-//! decimals), a sensor array's after them as in the file.
+//! decimals), a sensor array's and a produce item's after them as in the file.
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use tendril_run::trace::{TraceRow, array_columns};
+use tendril_run::trace::{PRODUCE_COLUMNS, TraceRow, array_columns};
 
 /// How a column is read from a row.
 enum Column {
@@ -50,6 +50,15 @@ fn array_values(r: &TraceRow) -> impl Iterator<Item = f64> + '_ {
     pads.iter().flat_map(|p| [p.true_force_n, p.fbg1_nm, p.fbg2_nm, p.force_n]).chain(control)
 }
 
+/// A produce item's values of a row, in the order of [`PRODUCE_COLUMNS`] (none for a rigid
+/// object): the pressure, the area above the bruise threshold, the stem's tension, 1 while the
+/// item hangs from its plant, and the pad's bump's force alone.
+fn produce_values(r: &TraceRow) -> impl Iterator<Item = f64> + '_ {
+    r.produce.iter().flat_map(|p| {
+        [p.pressure_kpa, p.bruise_area_mm2, p.stem_tension_n, f64::from(u8::from(p.on_plant)), p.bump_force_n]
+    })
+}
+
 /// Every column of `rows` as `(name, kind, data)`: kind `"f8"` with little-endian float64
 /// bytes, `"bool"` with one byte a row, or `"str"` with a list of the phases' names.
 pub fn columns<'py>(py: Python<'py>, rows: &[TraceRow]) -> PyResult<Vec<(String, &'static str, Bound<'py, PyAny>)>> {
@@ -82,6 +91,17 @@ pub fn columns<'py>(py: Python<'py>, rows: &[TraceRow]) -> PyResult<Vec<(String,
     for (name, bytes) in names.into_iter().zip(data) {
         out.push((name, "f8", PyBytes::new(py, &bytes).into_any()));
     }
+    if rows.first().is_some_and(|r| r.produce.is_some()) {
+        let mut data: Vec<Vec<u8>> = vec![Vec::with_capacity(8 * rows.len()); PRODUCE_COLUMNS.len()];
+        for r in rows {
+            for (bytes, value) in data.iter_mut().zip(produce_values(r)) {
+                bytes.extend_from_slice(&value.to_le_bytes());
+            }
+        }
+        for (name, bytes) in PRODUCE_COLUMNS.into_iter().zip(data) {
+            out.push((name.to_string(), "f8", PyBytes::new(py, &bytes).into_any()));
+        }
+    }
     Ok(out)
 }
 
@@ -96,6 +116,9 @@ pub fn row_dict<'py>(py: Python<'py>, r: &TraceRow) -> PyResult<Bound<'py, PyDic
         }
     }
     for (name, value) in array_columns(r.array.pads.len()).into_iter().zip(array_values(r)) {
+        d.set_item(name, value)?;
+    }
+    for (name, value) in PRODUCE_COLUMNS.into_iter().zip(produce_values(r)) {
         d.set_item(name, value)?;
     }
     Ok(d)

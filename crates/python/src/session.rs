@@ -102,7 +102,10 @@ impl Session {
     /// estimates, empty without one), `control_force_n` (what the controller regulates),
     /// `force_uncompensated_n`, `over_range`, `setpoint_n`, `time_to_motion_s`, `arm_q_rad`,
     /// `growth_motor_rad`, `twine_motor_rad`, `tool_load_n` and `truth` (the ground truth: `sensor_force_n`, `grip_force_n`,
-    /// `object_height_m`, `slip_speed_m_s`, `in_contact`).
+    /// `object_height_m`, `slip_speed_m_s`, `in_contact`, and for a produce item `produce`: the
+    /// contact pressure now and its peak so far \[kPa\], what pressed there, the bruise threshold
+    /// \[kPa\], the area above it \[mm²\], the time above it \[s\], `bruised`, the stem's tension
+    /// \[N\] and `on_plant`).
     fn observation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let seen = self.lock().session.as_ref().and_then(|s| s.observation());
         seen.map(|o| observation_dict(py, &o)).transpose()
@@ -235,6 +238,20 @@ fn observation_dict<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py
             td.set_item("object_height_m", t.object_height_m)?;
             td.set_item("slip_speed_m_s", t.slip_speed_m_s)?;
             td.set_item("in_contact", t.in_contact)?;
+            if let Some(p) = &t.produce {
+                // A produce item's damage and stem (summary's units: kPa, mm²).
+                let pd = PyDict::new(py);
+                pd.set_item("pressure_kpa", p.pressure_pa / 1e3)?;
+                pd.set_item("peak_pressure_kpa", p.peak_pa / 1e3)?;
+                pd.set_item("peak_at", p.peak_at)?;
+                pd.set_item("bruise_threshold_kpa", p.bruise_pa / 1e3)?;
+                pd.set_item("bruise_area_mm2", p.area_above_m2 * 1e6)?;
+                pd.set_item("time_above_s", p.time_above_s)?;
+                pd.set_item("bruised", p.peak_pa > p.bruise_pa)?;
+                pd.set_item("stem_tension_n", p.stem_tension_n)?;
+                pd.set_item("on_plant", p.harvest && p.detached_s.is_none())?;
+                td.set_item("produce", pd)?;
+            }
             Some(td)
         }
     };

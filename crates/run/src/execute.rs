@@ -180,6 +180,10 @@ pub fn summarize(
             super::metrics::fluctuation_outside_push_pct(&report.rows, drop_time_s, push);
     }
     let mut summary = RunSummary::new(scenario.identity(backend), report, started.wall_s(), started.thread_cpu_s());
+    if scenario.task.settled_grasp.enabled {
+        summary.grasp_duration_s = report.grasp.map(|g| g.duration_s);
+    }
+    summary.detection = scenario.detection();
     // The run's own thread stepped its physics (and compiled its model, if not cached).
     summary.warnings = tendril_twin::mujoco_log::take_warnings();
     summary

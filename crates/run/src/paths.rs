@@ -42,6 +42,18 @@ pub fn resolve_object(table: &mut toml::Table, scenario: &Path) {
     }
 }
 
+/// Resolves `detector.table`, when relative, against `scenario`'s folder.
+pub fn resolve_detector_table(table: &mut toml::Table, scenario: &Path) {
+    let Some(toml::Value::Table(detector)) = table.get_mut("detector") else { return };
+    if let Some(toml::Value::String(file)) = detector.get("table")
+        && Path::new(file).is_relative()
+    {
+        let joined = scenario.parent().unwrap_or(Path::new("")).join(file);
+        let joined = std::fs::canonicalize(&joined).unwrap_or(joined);
+        detector.insert("table".into(), toml::Value::String(joined.display().to_string()));
+    }
+}
+
 /// Resolves `physics.models_dir` against `scenario`: a relative folder is taken from the scenario's
 /// folder; none given, `models/` beside the scenario's folder is used when it holds finger.xml.
 /// Only scenarios of a scene (those with an `[object]` or `[physics]` table) get one; the bench

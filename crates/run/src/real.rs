@@ -126,7 +126,7 @@ pub fn run_on_real_with(
          make it with Devices::config or hardware_for"
     );
     let started = super::clock::RunClock::start();
-    let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator);
+    let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator, &scenario.gripper);
     let mut cell = LimitedCell::new(RealCell::new(config), limits);
     run_on_cell_with(&mut cell, scenario, out, started, driver)
 }

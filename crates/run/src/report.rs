@@ -5,6 +5,7 @@ use super::trace::TraceRow;
 use serde::Serialize;
 use tendril_cell::Phase;
 use tendril_control::slip::{Alarms, Judgement, SlipEvents};
+use tendril_control::task::{GraspOutcome, HoldRecord};
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -16,6 +17,21 @@ pub enum Outcome {
     Dropped,
     /// The run stopped on an error (physics divergence, device fault).
     Error,
+    /// The grasp did not settle within `task.settled_grasp.timeout_s`: the finger let go and the
+    /// arm never lifted (a safe failure of the cycle).
+    NotGrasped,
+}
+
+impl Outcome {
+    /// The outcome as `summary.json` and `results.csv` write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Held => "held",
+            Outcome::Dropped => "dropped",
+            Outcome::Error => "error",
+            Outcome::NotGrasped => "not_grasped",
+        }
+    }
 }
 
 /// When and where the object was lost.
@@ -59,6 +75,13 @@ pub struct RunReport {
     pub device_timing: Option<tendril_cell::DeviceTiming>,
     /// A sensor array's figures and slip cue (`None` with the paper's single pad).
     pub array: Option<super::array_summary::ArraySummary>,
+    /// How the grasp ended and how long it lasted (`None` if the run never got past it).
+    pub grasp: Option<GraspOutcome>,
+    /// What the long hold did (`task.hold`) and how far the twine went.
+    pub hold: HoldRecord,
+    /// A produce item's damage and stem at the end of the run (`None` for a rigid object, or
+    /// without ground truth).
+    pub produce: Option<tendril_cell::ProduceTruth>,
 }
 
 /// Consecutive invalid sensor samples (no estimate: non-finite, or below the calibration curve)

@@ -28,7 +28,7 @@ pub fn run_on_ros2(
     // Disturbances are the twin's: refuse before joining the graph.
     scenario.disturbance.refuse_on_real().map_err(|e| anyhow::anyhow!("{e}"))?;
     let started = super::clock::RunClock::start();
-    let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator);
+    let limits = SafetyLimits::for_task(&scenario.task.limits, &scenario.estimator, &scenario.gripper);
     let mut cell = LimitedCell::new(Ros2Cell::new(config), limits);
     run_on_cell_with(&mut cell, scenario, out, started, driver)
 }

@@ -8,6 +8,8 @@
 //! ```
 //! Everything else has the paper's or the model's documented defaults; see `scenarios/*.toml`.
 
+use super::detector::{Detection, DetectorConfig};
+use super::object_table::ObjectTable;
 use super::runner::ControlPlan;
 use super::summary::{Gains, RunIdentity};
 use serde::{Deserialize, Serialize};
@@ -22,7 +24,9 @@ use tendril_fbg::estimate::ForceCalibration;
 use tendril_fbg::{InterrogatorConfig, SensorConfig};
 use tendril_ros2::Ros2Config;
 use tendril_twin::disturbance::DisturbanceConfig;
-use tendril_twin::physics::{FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, SceneModel, SceneSpec};
+use tendril_twin::physics::{
+    FingerConfig, ObjectConfig, PadPlace, PhysicsConfig, ProduceConfig, SceneModel, SceneSpec,
+};
 use tendril_twin::sim::{EnvironmentConfig, SimCell};
 use tendril_twin::wrist::WristConfig;
 
@@ -51,6 +55,10 @@ pub struct PickPlaceScenario {
     pub control_rate_hz: f64,
     /// The object.
     pub object: ObjectConfig,
+    /// A produce item's properties within their literature range, its harvest and its flex's
+    /// numerics (read when the object is a produce item; docs/guide/objects.md).
+    #[serde(default, skip_serializing_if = "ProduceConfig::is_default")]
+    pub produce: ProduceConfig,
     /// The force controller: `type` (default `"pid"`) and that type's gains and limits.
     #[serde(default)]
     pub controller: ControllerConfig,
@@ -99,6 +107,10 @@ pub struct PickPlaceScenario {
     /// `--bag` (docs/cell/ros2.md); the defaults are a Humble lab's.
     #[serde(default, skip_serializing_if = "Ros2Config::is_default")]
     pub ros2: Ros2Config,
+    /// A simulated object detector whose class chooses the setpoint and the controller's keys from
+    /// a per-object table; none by default (the scenario's own settings).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detector: Option<DetectorConfig>,
 }
 
 fn default_seed() -> u64 {
@@ -117,7 +129,10 @@ impl Validate for PickPlaceScenario {
     fn prepare(table: &mut toml::Table, file: &std::path::Path) {
         super::paths::resolve_models(table, file);
         super::paths::resolve_object(table, file);
+        super::paths::resolve_detector_table(table, file);
         super::backend_defaults::fill_backend_defaults(table);
+        super::detector::apply(table);
+        super::produce_defaults::fill_produce_defaults(table);
     }
 
     fn validate(&self, at: &mut Checker) {
@@ -126,6 +141,7 @@ impl Validate for PickPlaceScenario {
         // The sections first: a cross-check below that reads a bad value (estimator.range_n = nan)
         // must not be reported on the key that reads it (setpoint_n).
         at.section("object", &self.object);
+        at.section("produce", &self.produce);
         at.section("controller", &self.controller);
         at.section("task", &self.task);
         at.section("gripper", &self.gripper);
@@ -140,6 +156,10 @@ impl Validate for PickPlaceScenario {
         at.section("hardware", &self.hardware);
         at.section("disturbance", &self.disturbance);
         at.section("ros2", &self.ros2);
+        if let Some(d) = &self.detector {
+            at.section("detector", d);
+            super::detector::check(d, &self.object.label(), at);
+        }
         at.require(
             "disturbance.push",
             self.disturbance.push.is_none() || self.physics.backend == tendril_twin::physics::Backend::Mujoco,
@@ -161,6 +181,21 @@ impl Validate for PickPlaceScenario {
         at.require("task.wrap_contact_n", self.task.wrap_contact_n < self.estimator.range_n, || {
             format!("must be below the sensor's range {} N, got {}", self.estimator.range_n, self.task.wrap_contact_n)
         });
+        let settled = &self.task.settled_grasp;
+        let resolution_n = tendril_control::settle::RESOLUTION_N;
+        at.require(
+            "task.settled_grasp.band_pct",
+            !settled.enabled || settled.band_n(self.setpoint_n) >= resolution_n,
+            || {
+                format!(
+                    "a band of ±{:.2} mN around the {} N setpoint is finer than the sensor's resolution ({} mN, paper \
+                 Sec. IV-B): it can never be told from noise",
+                    settled.band_n(self.setpoint_n) * 1e3,
+                    self.setpoint_n,
+                    resolution_n * 1e3
+                )
+            },
+        );
         let tendon_max_m = self.gripper.tendon_pull_m(self.gripper.twine_max_deg.to_radians());
         at.require("gripper.twine_max_deg", tendon_max_m <= self.finger.twine_max_m + 1e-9, || {
             format!(
@@ -281,6 +316,7 @@ impl PickPlaceScenario {
                 })
                 .collect(),
             arm_q0: self.task.home_deg.map(f64::to_radians),
+            produce: self.produce.clone(),
         }
     }
 
@@ -308,6 +344,14 @@ impl PickPlaceScenario {
     /// not load, when no run can start).
     pub fn object_mass_kg(&self) -> f64 {
         self.object.mass_kg.unwrap_or_else(|| self.object.model().map_or(f64::NAN, |m| m.mass_kg))
+    }
+
+    /// What the detector reported for this run (`None` without a `[detector]`, or when its table
+    /// does not read, which validation refuses): the same draw that chose the run's settings.
+    pub fn detection(&self) -> Option<Detection> {
+        let d = self.detector.as_ref()?;
+        let table = ObjectTable::read(&d.table).ok()?;
+        Some(d.draw(self.seed, &self.object.label(), &table.class_names(), table.fallback.is_some()))
     }
 
     /// What the control side needs.

@@ -23,7 +23,7 @@ use super::metrics::control_metrics;
 use super::plan::ControlPlan;
 use super::report::{Drop, Outcome, RunReport};
 use super::samples::{InvalidSamples, TareAverager};
-use super::trace::{ArrayRow, PadRow, TraceRow, TraceWriter};
+use super::trace::{ArrayRow, PadRow, ProduceRow, TraceRow, TraceWriter};
 use tendril_cell::{Cell, CellError, CellState, GroundTruth, Phase, Wavelengths};
 use tendril_control::array_cue::ArrayCue;
 use tendril_control::controller::ForceController;
@@ -388,6 +388,13 @@ impl<C: Cell> Session<C> {
             grip_force_n: truth.map_or(nan, |t| t.grip_force_n),
             tool_load_n: state.tool_load_n.unwrap_or(nan),
             array: array_row(&state, truth.as_ref(), &p.array, force_n),
+            produce: truth.and_then(|t| t.produce).map(|p| ProduceRow {
+                pressure_kpa: p.pressure_pa / 1e3,
+                bruise_area_mm2: p.area_above_m2 * 1e6,
+                stem_tension_n: p.stem_tension_n,
+                on_plant: p.harvest && p.detached_s.is_none(),
+                bump_force_n: p.pad_bump_force_n,
+            }),
         };
         if let Some(w) = self.trace.as_mut() {
             w.write(&row).map_err(|e| CellError::Device { device: "trace".into(), cause: e.to_string() })?;
@@ -439,9 +446,12 @@ impl<C: Cell> Session<C> {
         let sensor_drop = slip.events().dropped_s.map(|t| Drop { cell_time_s: t, phase: phase_at(&rows, t) });
         let has_truth = rows.first().is_some_and(|r| r.true_force_n.is_finite());
         let drop = if has_truth { self.truth_drop } else { sensor_drop };
+        let grasp = self.sequencer.grasp_outcome();
+        let timed_out = grasp.is_some_and(|g| g.end == tendril_control::settle::GraspEnd::TimedOut);
         let outcome = match (&error, drop) {
             (Some(_), _) => Outcome::Error,
             (None, Some(_)) => Outcome::Dropped,
+            (None, None) if timed_out => Outcome::NotGrasped,
             (None, None) => Outcome::Held,
         };
         let metrics = control_metrics(&rows, drop.map(|d| d.cell_time_s));
@@ -455,7 +465,9 @@ impl<C: Cell> Session<C> {
                 self.plan.calibration.range_n,
             )
         });
+        let produce = self.cell.ground_truth().and_then(|t| t.produce);
         let report = RunReport {
+            produce,
             outcome,
             drop,
             motion_start_s: self.sequencer.motion_start_s(),
@@ -470,6 +482,8 @@ impl<C: Cell> Session<C> {
             rows,
             device_timing,
             array,
+            grasp,
+            hold: self.sequencer.hold_record(),
         };
         (report, self.trace.take())
     }

@@ -1,7 +1,7 @@
 //! `summary.json`: the one-record result of a run, also the row of a sweep's `results.csv`.
 
 use super::metrics::ControlMetrics;
-use super::runner::{Outcome, RunReport};
+use super::runner::RunReport;
 use serde::{Deserialize, Serialize};
 
 /// PID gains as reported.
@@ -39,6 +39,20 @@ pub struct RunIdentity {
     pub backend: String,
 }
 
+/// What a long hold did (`task.hold`) and how far the twine motor went.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct HoldSummary {
+    /// Times the grasp let go of the object waiting on the table and wrapped it again.
+    pub releases: u32,
+    /// Cell time at which the twine motor first reached the end of its travel \[s\] (absent: it
+    /// never did).
+    pub travel_end_cell_time_s: Option<f64>,
+    /// The largest twine motor angle during the grasp, as a fraction of its travel [-].
+    pub max_grasp_travel: f64,
+    /// The largest over the run [-].
+    pub max_travel: f64,
+}
+
 /// The summary of one run. Times are in seconds; `drop_time_s` counts from the moment the arm
 /// started moving the object (the paper's Fig. 9 time axis), `drop_cell_time_s` from activation.
 /// The identity and the control metrics are flattened into the record (and the CSV row).
@@ -47,7 +61,8 @@ pub struct RunSummary {
     /// Scenario, object, gains, seed, backend.
     #[serde(flatten)]
     pub run: RunIdentity,
-    /// "held", "dropped" or "error".
+    /// "held", "dropped", "error" or "not_grasped" (a settled grasp that timed out: let go
+    /// without lifting).
     pub outcome: String,
     /// Time of the drop after the arm started moving \[s\].
     pub drop_time_s: Option<f64>,
@@ -111,6 +126,21 @@ pub struct RunSummary {
     /// single pad).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub array: Option<super::array_summary::ArraySummary>,
+    /// With `task.settled_grasp`: how long the grasp lasted until it settled or timed out \[s\]
+    /// (absent with the paper's fixed grasp).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grasp_duration_s: Option<f64>,
+    /// A long hold's record: present when the grasp let go and re-wrapped (`task.hold`) or the
+    /// twine reached the end of its travel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hold: Option<HoldSummary>,
+    /// With a `[detector]`: the class it reported and whose settings the run used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detection: Option<super::detector::Detection>,
+    /// With a produce item: the damage the grip did and the harvest's end (absent for a rigid
+    /// object).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub produce: Option<super::produce_summary::ProduceSummary>,
     /// MuJoCo's warnings during the run (see [`tendril_twin::mujoco_log`]), at most
     /// [`tendril_twin::mujoco_log::MAX_KEPT`]; in `results.csv` joined by `; `.
     #[serde(default)]
@@ -131,9 +161,17 @@ impl RunSummary {
 
     /// The column names of a flattened summary, in order (nested fields dotted: `gains.kp`).
     pub fn columns() -> Vec<String> {
-        // A sensor array's columns too, so that one results file holds runs with and without one
-        // (empty for the paper's single pad); a real cell's device timing is not a sweep's.
-        let with_array = RunSummary { array: Some(Default::default()), ..RunSummary::default() };
+        // A sensor array's and a produce item's columns too, so that one results file holds runs
+        // with and without them (empty for the paper's single pad and a rigid object); a real
+        // cell's device timing is not a sweep's.
+        let with_array = RunSummary {
+            array: Some(Default::default()),
+            grasp_duration_s: Some(0.0),
+            hold: Some(Default::default()),
+            detection: Some(Default::default()),
+            produce: Some(Default::default()),
+            ..RunSummary::default()
+        };
         flatten_summary(&with_array).into_iter().map(|(k, _)| k).collect()
     }
 
@@ -148,12 +186,7 @@ impl RunSummary {
         let since_motion = |t: f64| report.motion_start_s.map(|m| t - m);
         RunSummary {
             run: id,
-            outcome: match report.outcome {
-                Outcome::Held => "held",
-                Outcome::Dropped => "dropped",
-                Outcome::Error => "error",
-            }
-            .to_string(),
+            outcome: report.outcome.name().to_string(),
             drop_time_s: report.drop.and_then(|d| since_motion(d.cell_time_s)),
             drop_cell_time_s: report.drop.map(|d| d.cell_time_s),
             drop_phase: report.drop.map(|d| d.phase.name().to_string()),
@@ -174,9 +207,32 @@ impl RunSummary {
             dropped_samples: report.dropped_samples,
             device_timing: report.device_timing,
             array: report.array.clone(),
+            grasp_duration_s: None,
+            hold: hold_summary(report),
+            detection: None,
+            produce: report.produce.as_ref().map(|p| {
+                super::produce_summary::ProduceSummary::new(
+                    p,
+                    report.outcome,
+                    report.drop,
+                    report.motion_start_s,
+                    &report.rows,
+                )
+            }),
             warnings: Vec::new(),
         }
     }
+}
+
+/// The hold's record when there is something to report: a release, or the travel's end.
+fn hold_summary(report: &RunReport) -> Option<HoldSummary> {
+    let h = &report.hold;
+    (h.releases > 0 || h.travel_end_s.is_some()).then_some(HoldSummary {
+        releases: h.releases,
+        travel_end_cell_time_s: h.travel_end_s,
+        max_grasp_travel: h.max_grasp_travel,
+        max_travel: h.max_travel,
+    })
 }
 
 /// A short human-readable summary, a line per figure.
@@ -228,6 +284,22 @@ pub fn render_text(s: &RunSummary) -> String {
     if s.invalid_samples > 0 {
         out += &format!("  invalid samples    {} skipped (last valid estimate held)\n", s.invalid_samples);
     }
+    if let Some(g) = s.grasp_duration_s {
+        let how = if s.outcome == "not_grasped" { "timed out" } else { "settled" };
+        out += &format!("  settled grasp      {how} after {g:.2} s\n");
+    }
+    if let Some(h) = &s.hold {
+        out += &format!(
+            "  long hold          {} release(s) and re-wrap(s); twine at most {:.0} % of its travel ({:.0} % in the grasp)",
+            h.releases,
+            100.0 * h.max_travel,
+            100.0 * h.max_grasp_travel
+        );
+        if let Some(t) = h.travel_end_cell_time_s {
+            out += &format!("; at the travel's end at {t:.1} s");
+        }
+        out += "\n";
+    }
     out += &format!("  rise time (90 %)   {}\n", opt(s.metrics.rise_time_90_s, "s"));
     out += &format!("  overshoot          {:.1} %\n", s.metrics.overshoot_pct);
     out += &format!("  max fluctuation    {}\n", opt(s.metrics.max_fluctuation_pct, "%"));
@@ -238,6 +310,9 @@ pub fn render_text(s: &RunSummary) -> String {
     if let Some(a) = &s.array {
         out += &render_array(a);
     }
+    if let Some(p) = &s.produce {
+        out += &render_produce(p);
+    }
     out += &format!(
         "  simulated {:.1} s in {:.2} s wall ({}x real time), {:.2} s of CPU ({}x)\n",
         s.sim_time_s,
@@ -246,6 +321,35 @@ pub fn render_text(s: &RunSummary) -> String {
         s.cpu_time_s,
         speed_factor(s.sim_s_per_cpu_s)
     );
+    out
+}
+
+/// A produce item's lines of the text summary: the damage, and the harvest's end.
+fn render_produce(p: &super::produce_summary::ProduceSummary) -> String {
+    let mut out = format!(
+        "  contact pressure   peak {:.0} kPa ({}), bruise threshold {:.0} kPa: {}\n",
+        p.peak_pressure_kpa,
+        if p.peak_at.is_empty() { "no contact" } else { p.peak_at.as_str() },
+        p.bruise_threshold_kpa,
+        if p.bruised {
+            format!("bruised, {:.1} mm² above it at most, for {:.2} s", p.bruise_area_mm2, p.time_above_s)
+        } else {
+            "not bruised".into()
+        }
+    );
+    if let Some(share) = p.bump_share {
+        out += &format!("  pad on the item    the bump carries {:.0} % of the pad's force while held\n", 100.0 * share);
+    }
+    if let Some(h) = &p.harvest {
+        out += &format!("  harvest            {h}");
+        if let Some(t) = p.detached_s {
+            out += &format!(", the stem let go {t:.2} s after the arm started moving");
+        }
+        if let (Some(max), Some(d)) = (p.max_stem_tension_n, p.detach_n) {
+            out += &format!(" (stem tension up to {max:.2} N, lets go at {d:.2} N)");
+        }
+        out += "\n";
+    }
     out
 }
 

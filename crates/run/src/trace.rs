@@ -28,6 +28,27 @@ pub struct ArrayRow {
     pub control_force_n: f64,
 }
 
+/// A produce item's columns of one tick (what only a simulation knows).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ProduceRow {
+    /// The largest peak contact pressure on the item at the tick's last physics step \[kPa\].
+    pub pressure_kpa: f64,
+    /// The area above its bruise threshold then \[mm²\].
+    pub bruise_area_mm2: f64,
+    /// The stem's tension \[N\] (0 without a stem, or once it let go).
+    pub stem_tension_n: f64,
+    /// Whether the item still hangs from its plant.
+    pub on_plant: bool,
+    /// Normal force on the pad's bump alone \[N\] (`true_force_n` is the bump's and the casing's).
+    pub bump_force_n: f64,
+}
+
+/// The columns a produce item adds after all others (none for a rigid object): the contact
+/// pressure, the area above the bruise threshold, the stem's tension, whether the item still
+/// hangs from its plant, and the pad's bump's share of its force (the bump's force alone).
+pub const PRODUCE_COLUMNS: [&str; 5] =
+    ["pressure_kpa", "bruise_area_mm2", "stem_tension_n", "on_plant", "bump_force_n"];
+
 /// One control tick, as written to `trace.csv`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TraceRow {
@@ -67,6 +88,8 @@ pub struct TraceRow {
     pub tool_load_n: f64,
     /// A sensor array's further pads (empty without one).
     pub array: ArrayRow,
+    /// A produce item's pressure and stem (`None` for a rigid object, or without ground truth).
+    pub produce: Option<ProduceRow>,
 }
 
 impl TraceRow {
@@ -100,6 +123,7 @@ impl TraceRow {
             grip_force_n: 0.0,
             tool_load_n: 0.0,
             array: ArrayRow::default(),
+            produce: None,
         }
     }
 }
@@ -189,6 +213,11 @@ impl TraceWriter {
             for name in array_columns(r.array.pads.len()) {
                 write!(self.buffer, ",{name}")?;
             }
+            if r.produce.is_some() {
+                for name in PRODUCE_COLUMNS {
+                    write!(self.buffer, ",{name}")?;
+                }
+            }
             self.buffer.push(b'\n');
         }
         // Formatted straight into the row buffer: no allocation per control tick.
@@ -218,6 +247,17 @@ impl TraceWriter {
         }
         if !r.array.pads.is_empty() {
             write!(self.buffer, ",{:.5}", r.array.control_force_n)?;
+        }
+        if let Some(p) = &r.produce {
+            write!(
+                self.buffer,
+                ",{:.3},{:.4},{:.4},{},{:.5}",
+                p.pressure_kpa,
+                p.bruise_area_mm2,
+                p.stem_tension_n,
+                u8::from(p.on_plant),
+                p.bump_force_n
+            )?;
         }
         self.buffer.push(b'\n');
         if self.buffer.len() >= BUFFER_BYTES { self.flush_rows() } else { Ok(()) }

@@ -282,6 +282,12 @@ impl SimCell {
         self.scene.as_ref()?.contact_census()
     }
 
+    /// The area of the finger's faces touching the object now \[m²\] (MuJoCo only; see
+    /// [`crate::physics::Scene::contact_area_m2`]).
+    pub fn contact_area_m2(&self) -> Option<f64> {
+        self.scene.as_ref()?.contact_area_m2()
+    }
+
     /// The frames recorded so far, if [`SimCell::record_frames`] was asked for and the backend has
     /// a MuJoCo state.
     pub fn take_frames(&mut self) -> Option<crate::frames::FrameLog> {
@@ -493,6 +499,24 @@ impl Cell for SimCell {
             slip_speed_m_s: r.slip_speed_m_s,
             in_contact: r.touching,
             object_in_hand_m: r.object_in_hand_m,
+            produce: r.produce.zip(self.model.produce()).map(|(p, part)| {
+                let props = &part.item.properties;
+                tendril_cell::ProduceTruth {
+                    pressure_pa: p.damage.now_peak_pa,
+                    area_above_m2: p.damage.now_area_above_m2,
+                    peak_pa: p.damage.peak_pa,
+                    peak_at: p.damage.peak_at.map_or("", |t| t.name()),
+                    max_area_above_m2: p.damage.max_area_above_m2,
+                    time_above_s: p.damage.time_above_s,
+                    bruise_pa: props.bruise_pa,
+                    harvest: p.harvest,
+                    stem_tension_n: p.stem_tension_n,
+                    max_stem_tension_n: p.max_stem_tension_n,
+                    detach_n: props.detach_n,
+                    detached_s: p.detached_s,
+                    pad_bump_force_n: p.bump_force_n,
+                }
+            }),
         })
     }
 }

@@ -81,7 +81,11 @@ impl ContactCensus {
     }
 }
 
-/// A geom's name in `model` (`geom<id>` for an unnamed one).
+/// A geom's name in `model` (`geom<id>` for an unnamed one; `flex` for a contact's flex side,
+/// which has no geom: MuJoCo's -1).
 fn geom_name(model: &MjModel, g: usize) -> String {
+    if g >= model.ffi().ngeom as usize {
+        return "flex".into();
+    }
     model.id_to_name(_mjtObjBase::mjOBJ_GEOM, g).map_or_else(|| format!("geom{g}"), str::to_string)
 }

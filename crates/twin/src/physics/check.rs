@@ -94,6 +94,7 @@ pub fn run(s: &CheckScenario) -> Result<(), PhysicsError> {
         object: Some(s.object.clone()),
         extra_pads: Vec::new(),
         arm_q0: ur5e::HOME,
+        produce: Default::default(),
     };
     let mut scene = SceneModel::build(&spec)?.start()?;
     let c = &s.check;

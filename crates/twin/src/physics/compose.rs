@@ -1,7 +1,10 @@
 //! Assembles a scene's MJCF from the parts in models/ and the scenario's values.
 
-use super::config::{ArmMode, Cone, FingerConfig, Integrator, PhysicsConfig, Solver};
+use super::config::{ArmMode, Backend, FingerConfig, Integrator};
+pub use super::header::header;
 use super::object::ObjectModel;
+use super::plates::{self, Calibration};
+use super::produce::ProduceItem;
 use super::template::{num, nums, render, section};
 use super::{PadPlace, PhysicsError, SceneSpec};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -68,50 +71,6 @@ fn per_joint(x: f64) -> f64 {
 /// A model file without its leading comment (whose prose names the template's fields).
 fn body_of(text: &str) -> &str {
     text.split_once("-->").map_or(text, |(_, rest)| rest)
-}
-
-/// The `<compiler>`, `<option>` and contact `<default>` every scene (and validation scene) shares.
-/// Energy is enabled for the runaway check of a scene loaded elsewhere (a run's compiled model turns
-/// MuJoCo's per-step energies off and computes the kinetic energy itself: `SceneModel::build`);
-/// constraint islands are off (the cell is one island, and
-/// finding islands cost ~20 % of a step, measured with `perf stat` on `tendril physics-check`).
-pub fn header(p: &PhysicsConfig) -> String {
-    let integrator = match p.integrator {
-        Integrator::Euler => "Euler",
-        Integrator::Rk4 => "RK4",
-        Integrator::Implicit => "implicit",
-        Integrator::Implicitfast => "implicitfast",
-    };
-    let cone = match p.cone {
-        Cone::Pyramidal => "pyramidal",
-        Cone::Elliptic => "elliptic",
-    };
-    let solver = match p.solver {
-        Solver::Newton => "Newton",
-        Solver::Cg => "CG",
-        Solver::Pgs => "PGS",
-    };
-    format!(
-        r#"<compiler angle="radian" autolimits="true"/>
-  <option timestep="{dt}" integrator="{integrator}" cone="{cone}" impratio="{imp}" solver="{solver}"
-          iterations="{it}" tolerance="{tol}" ls_iterations="{ls}" noslip_iterations="{ns}"
-          noslip_tolerance="{nstol}">
-    <flag energy="enable" island="disable"/>
-  </option>
-  <default>
-    <geom solref="{tc} {dr}" solimp="{si} 0.5 2"/>
-  </default>"#,
-        dt = num(p.timestep_s),
-        imp = num(p.impratio),
-        it = p.iterations,
-        tol = num(p.tolerance),
-        ls = p.ls_iterations,
-        ns = p.noslip_iterations,
-        nstol = num(p.noslip_tolerance),
-        tc = num(p.contact_timeconst_s),
-        dr = num(p.contact_dampratio),
-        si = nums(&p.contact_solimp),
-    )
 }
 
 /// The finger part (hand, motors, strip, pad) with its tendons, actuators and sensor, as a full MJCF
@@ -213,6 +172,20 @@ pub fn finger(f: &FingerConfig, extra_pads: &[PadPlace], models: Option<&Path>) 
     )
 }
 
+/// How far below a harvested item the bench stands \[m\]: 0.25 m, clear of the item and the
+/// finger while the arm pulls the item down off its plant (a stated choice of the harvest's
+/// layout: the item hangs from its plant, nothing under it).
+pub const HARVEST_BENCH_DROP_M: f64 = 0.25;
+
+/// A produce item in a scene: the item as the scenario configures it, and its flex's calibration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProducePart {
+    /// The item, `[produce]` and `[object]` overrides applied.
+    pub item: ProduceItem,
+    /// The contact stiffness that meets Hertz in the plate test ([`plates::calibrate`]).
+    pub calibration: Calibration,
+}
+
 /// Where the scene's parts stand at the start, in the world frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Placement {
@@ -242,11 +215,36 @@ pub fn placement(spec: &SceneSpec, object: Option<&ObjectModel>) -> Placement {
         Some([x, y]) => (x, y),
         None => (wrap.x, wrap.y),
     };
-    Placement { hand, object: Some(Vector3::new(x, y, base_z)), table_z: base_z }
+    let harvest = model.produce.is_some() && spec.produce.harvest;
+    let table_z = if harvest { base_z - HARVEST_BENCH_DROP_M } else { base_z };
+    Placement { hand, object: Some(Vector3::new(x, y, base_z)), table_z }
 }
 
-/// The full scene MJCF for `spec`, and where its parts start.
-pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
+/// The produce item of `spec` as its scenario configures it, calibrated: refused on the rapier
+/// backend (it has no flex) and with an integrator that does not integrate a flex's elasticity.
+fn produce_part(spec: &SceneSpec, raw: &ProduceItem) -> Result<ProducePart, PhysicsError> {
+    if spec.physics.backend == Backend::Rapier {
+        return Err(PhysicsError::Unsupported {
+            backend: "rapier",
+            what: format!("the produce item {} (a MuJoCo flex); use physics.backend = \"mujoco\"", raw.source),
+        });
+    }
+    if matches!(spec.physics.integrator, Integrator::Implicit | Integrator::Implicitfast) {
+        return Err(PhysicsError::Config {
+            key: "physics.integrator".into(),
+            reason: "a produce item's flex needs \"discrete\" (or \"euler\"): MuJoCo 3.17 integrates flex \
+                     elasticity implicitly only in the discrete integrator"
+                .into(),
+        });
+    }
+    let object = spec.object.as_ref();
+    let item = raw.configured(&spec.produce, object.and_then(|o| o.mass_kg), object.and_then(|o| o.friction))?;
+    let calibration = plates::calibrate(&item, &spec.physics)?;
+    Ok(ProducePart { item, calibration })
+}
+
+/// The full scene MJCF for `spec`, where its parts start, and its produce item if it has one.
+pub fn scene(spec: &SceneSpec) -> Result<(String, Placement, Option<ProducePart>), PhysicsError> {
     let models = spec.physics.models_dir.as_deref();
     let object = spec.object.as_ref().map(|o| o.model()).transpose()?;
     let place = placement(spec, object.as_ref());
@@ -257,10 +255,25 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
     // The object's assets (meshes), with their files already made absolute by ObjectModel.
     let asset = object.as_ref().map_or("", |o| section(&o.mjcf, "asset")).to_string();
 
+    let mut produce = None;
     if spec.object.is_some() {
         let table = part(models, "table.xml")?.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
         worldbody.push_str(section(&table, "worldbody"));
-        worldbody.push_str(section(object.as_ref().map_or("", |o| o.mjcf.as_str()), "worldbody"));
+        match (object.as_ref().and_then(|o| o.produce.as_ref()), place.object) {
+            (Some(raw), Some(foot)) => {
+                let p = produce_part(spec, raw)?;
+                // The item's centre stands its height above its footprint, in a static frame its
+                // flex's nodes slide in.
+                let centre = [foot.x, foot.y, foot.z + p.item.radii_m[2]];
+                worldbody.push_str(&format!(
+                    "\n    <body name=\"produce_frame\" pos=\"{}\">{}</body>\n",
+                    nums(&centre),
+                    section(&p.item.document(p.calibration.contact(&spec.physics)), "worldbody")
+                ));
+                produce = Some(p);
+            }
+            _ => worldbody.push_str(section(object.as_ref().map_or("", |o| o.mjcf.as_str()), "worldbody")),
+        }
     }
     // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
     // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
@@ -280,5 +293,5 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement), PhysicsError> {
          <sensor>{sensor}</sensor>\n</mujoco>\n",
         header = header(&spec.physics),
     );
-    Ok((xml, place))
+    Ok((xml, place, produce))
 }

@@ -17,6 +17,11 @@ pub enum Integrator {
     Implicit,
     /// Implicit in velocity, skipping Coriolis derivatives: damping and servo `kv` implicit, cheap.
     Implicitfast,
+    /// MuJoCo's discrete integrator (3.13 on): the constraint solve and the implicit velocity
+    /// update in one, in the metric `M + hD + h²K` that holds damping and stiffness. A produce
+    /// item's flex elasticity needs it (MuJoCo 3.17 integrates a flex's elasticity implicitly only
+    /// here).
+    Discrete,
 }
 
 /// Friction cone (`<option cone>`).

@@ -66,6 +66,12 @@ pub trait Physics: Send {
         None
     }
 
+    /// The area of the finger's faces that touch the object now \[m²\] (see
+    /// [`super::Scene::contact_area_m2`]); `None` when the backend does not report its contacts.
+    fn contact_area_m2(&self) -> Option<f64> {
+        None
+    }
+
     /// Steps for `seconds` of simulated time (rounded to whole steps).
     fn run_for(&mut self, seconds: f64) -> Result<(), PhysicsError> {
         let n = (seconds / self.timestep()).round() as usize;

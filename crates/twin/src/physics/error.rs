@@ -99,6 +99,15 @@ pub enum Divergence {
         /// Second geom.
         geom2: String,
     },
+    /// A produce item's flex turned an element inside out: its elastic forces mean nothing from
+    /// here on.
+    #[error("the produce item's flex inverted (element {element}, volume {volume_m3:.3e} m³)")]
+    FlexInverted {
+        /// The tetrahedron that inverted.
+        element: usize,
+        /// Its signed volume now (its sign flipped) \[m³\].
+        volume_m3: f64,
+    },
     /// Kinetic energy beyond `physics.max_kinetic_energy_j`.
     #[error("kinetic energy {joules:.3e} J beyond the bound")]
     Energy {

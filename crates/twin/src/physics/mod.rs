@@ -13,6 +13,8 @@
 //!   strip; [`census`]: contacts per geom pair over a run (what the collision search finds).
 //! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
 //! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
+//! - [`produce`]: a produce item's model file (a flex), [`plates`] its compression between two
+//!   plates and the calibration against [`hertz`], [`damage`] the contact pressure on it.
 //! - `spec.rs`: what a scene holds ([`SceneSpec`]); `engine.rs`: the [`Physics`] trait; `readout.rs`:
 //!   what a run hands out ([`PhysicsReadout`], [`Snapshot`]); `start.rs`: a run on a model
 //!   ([`SceneModel::start`]).
@@ -21,12 +23,19 @@ pub mod census;
 pub mod check;
 pub mod compose;
 pub mod config;
+pub mod damage;
 pub mod drive;
 mod engine;
 mod error;
 pub mod export;
 pub mod guide;
+mod header;
+pub mod hertz;
 pub mod object;
+pub mod plates;
+pub mod produce;
+pub mod produce_config;
+mod produce_run;
 pub mod rapier;
 mod readout;
 pub mod scene;
@@ -43,6 +52,8 @@ pub use config::{
 };
 pub use engine::Physics;
 pub use error::{Divergence, PhysicsError};
+pub use produce::ProduceItem;
+pub use produce_config::{Dof, ProduceConfig};
 pub use readout::{PhysicsReadout, Snapshot};
 pub use scene::{Scene, SceneModel};
 pub use spec::{PadPlace, SceneSpec};

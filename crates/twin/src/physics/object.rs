@@ -6,6 +6,9 @@
 //! the wrap starts. [`ObjectModel::from_mjcf`] compiles the file on its own, checks the contract
 //! and reads the mass, the grip radius and the wrap height from the compiled model, so a value is
 //! written once, in the file.
+//!
+//! A produce item is an object file of its own kind, a flex ([`super::produce`]): read here too,
+//! its mass and size taken from the flex, its wrap height from its centre.
 
 use super::PhysicsError;
 use mujoco_rs::mujoco_c::{_mjtGeomBase, _mjtObjBase, mjtJoint};
@@ -24,6 +27,9 @@ pub struct ObjectModel {
     pub grip_radius_m: f64,
     /// Height of the site `object_wrap` above the body origin (the footprint centre) \[m\].
     pub wrap_height_m: f64,
+    /// The produce item, when the file is one (its figures above are the flex's: the grip radius
+    /// its horizontal semi-axis, the wrap's height above its lowest point).
+    pub produce: Option<super::produce::ProduceItem>,
 }
 
 impl ObjectModel {
@@ -44,6 +50,17 @@ impl ObjectModel {
             None => mjcf.to_string(),
         };
         let mjcf = text.as_str();
+        if super::produce::is_produce(mjcf) {
+            let item = super::produce::ProduceItem::read(source, mjcf)?;
+            return Ok(ObjectModel {
+                source: source.to_string(),
+                mjcf: mjcf.to_string(),
+                mass_kg: item.mass_kg,
+                grip_radius_m: item.grip_radius_m(),
+                wrap_height_m: item.radii_m[2] + item.wrap_m,
+                produce: Some(item),
+            });
+        }
         let broken = |what: String| PhysicsError::Object { file: source.to_string(), what };
         let m = MjModel::from_xml_string(mjcf).map_err(|e| broken(format!("MuJoCo cannot compile it: {e:?}")))?;
         let find = |kind, kind_name: &str, name: &str| {
@@ -83,6 +100,7 @@ impl ObjectModel {
             mass_kg,
             grip_radius_m: m.geom_size()[grip][0],
             wrap_height_m: m.site_pos()[wrap][2],
+            produce: None,
         })
     }
 }

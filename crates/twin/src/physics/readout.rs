@@ -67,4 +67,6 @@ pub struct PhysicsReadout {
     /// rapier, whose friction impulses stay inside its solver, takes it from the object's momentum
     /// over the step. `None` where a backend cannot tell it.
     pub tool_load_n: Option<f64>,
+    /// A produce item's damage and stem (`None` for a rigid object).
+    pub produce: Option<super::produce_run::ProduceReadout>,
 }

@@ -1,10 +1,12 @@
 //! One simulation run of the cell: a compiled, shareable [`SceneModel`] and per-run [`Scene`] state.
 
 use super::census::ContactCensus;
-use super::compose::{self, Placement};
+use super::compose::{self, Placement, ProducePart};
 use super::config::{ArmMode, Backend};
+use super::damage::Toucher;
 use super::drive::{Drive, grip_in_hand};
 use super::guide::GuidePruning;
+use super::produce_run::{self, GeomShape, ProduceIds, ProduceRun};
 use super::{Divergence, PadPlace, Physics, PhysicsError, PhysicsReadout, SceneSpec, Snapshot};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtEnableBit, mjtState, mjtWarning};
 use mujoco_rs::prelude::{MjData, MjModel};
@@ -31,6 +33,8 @@ pub struct SceneModel {
     /// The model without the guide walls' contacts, stepped while they cannot touch the strip
     /// (`None`: the walls stay in throughout).
     guide_pruning: Option<Arc<GuidePruning>>,
+    /// The produce item, when the object is one: as configured, and its flex's calibration.
+    produce: Option<Arc<ProducePart>>,
 }
 
 /// Ids of the elements the readout and the backends need (MuJoCo's numbering, which the rapier
@@ -75,6 +79,10 @@ pub(crate) struct Ids {
     pub(crate) tendon_elastic: usize,
     pub(crate) tendon_maxwell: usize,
     pub(crate) pad_touch_adr: usize,
+    /// The produce item's flex (`None` for a rigid object).
+    pub(crate) produce: Option<ProduceIds>,
+    /// What each geom is to a produce item's damage figures (empty for a rigid object).
+    pub(crate) geom_shapes: Vec<Option<GeomShape>>,
 }
 
 fn id(model: &MjModel, kind: _mjtObjBase, kind_name: &'static str, name: &str) -> Result<usize, PhysicsError> {
@@ -90,10 +98,10 @@ impl SceneModel {
         if let Some((key, reason)) = checker.into_first_error() {
             return Err(PhysicsError::Config { key, reason });
         }
-        let (xml, placement) = compose::scene(spec)?;
+        let (xml, placement, produce) = compose::scene(spec)?;
         let mut model =
             MjModel::from_xml_string(&xml).map_err(|e| PhysicsError::Compile { message: format!("{e:?}") })?;
-        let ids = Self::find_ids(&model, spec)?;
+        let ids = Self::find_ids(&model, spec, produce.is_some())?;
 
         // Object: friction override on the grip the finger touches (its base keeps its own friction
         // against the table), start pose on the table.
@@ -129,8 +137,15 @@ impl SceneModel {
             }
         }
         let guide_pruning = GuidePruning::new(&model).map(Arc::new);
-        let shared =
-            Arc::new(SceneModel { model: Arc::new(model), spec: spec.clone(), placement, xml, ids, guide_pruning });
+        let shared = Arc::new(SceneModel {
+            model: Arc::new(model),
+            spec: spec.clone(),
+            placement,
+            xml,
+            ids,
+            guide_pruning,
+            produce: produce.map(Arc::new),
+        });
         if spec.physics.backend == Backend::Rapier {
             // Translate once now, so an element rapier cannot take is an error before any run starts.
             super::rapier::RapierWorld::build(&shared.model, &spec.physics, &shared.ids.arm_joint)?;
@@ -138,7 +153,7 @@ impl SceneModel {
         Ok(shared)
     }
 
-    fn find_ids(m: &MjModel, spec: &SceneSpec) -> Result<Ids, PhysicsError> {
+    fn find_ids(m: &MjModel, spec: &SceneSpec, produce: bool) -> Result<Ids, PhysicsError> {
         use _mjtObjBase::*;
         let geom = |n: &str| id(m, mjOBJ_GEOM, "geom", n);
         let joint = |n: &str| id(m, mjOBJ_JOINT, "joint", n);
@@ -153,7 +168,7 @@ impl SceneModel {
         for i in 0..super::strip::layout_with_pads(&spec.finger, &PadPlace::arcs(&spec.extra_pads)).len() {
             finger_geoms.push(geom(&format!("seg{i}"))?);
         }
-        let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() {
+        let (object_geoms, object_body, object_grip, object_qpos) = if spec.object.is_some() && !produce {
             let body = id(m, mjOBJ_BODY, "body", "object")?;
             let geoms = (0..m.ffi().ngeom as usize).filter(|&g| m.geom_bodyid()[g] as usize == body).collect();
             (geoms, Some(body), Some(geom("object_grip")?), Some(qpos("object")?))
@@ -193,11 +208,37 @@ impl SceneModel {
             }),
         };
         let touch = id(m, mjOBJ_SENSOR, "sensor", "pad_touch")?;
+        let palm = geom("palm")?;
+        let (produce, geom_shapes) = if produce {
+            let ngeom = m.ffi().ngeom as usize;
+            let bumps: Vec<usize> = std::iter::once(pad_geoms[1]).chain(extra_pad_geoms.iter().map(|p| p[1])).collect();
+            let casings: Vec<usize> =
+                std::iter::once(pad_geoms[0]).chain(extra_pad_geoms.iter().map(|p| p[0])).collect();
+            let shapes = (0..ngeom)
+                .map(|g| {
+                    let toucher = if bumps.contains(&g) {
+                        Toucher::PadBump
+                    } else if casings.contains(&g) {
+                        Toucher::PadCasing
+                    } else if finger_geoms.contains(&g) {
+                        Toucher::Strip
+                    } else if g == palm {
+                        Toucher::Palm
+                    } else {
+                        Toucher::Other
+                    };
+                    Some(GeomShape::of(m, g, toucher))
+                })
+                .collect();
+            (Some(ProduceIds::find(m)?), shapes)
+        } else {
+            (None, Vec::new())
+        };
         Ok(Ids {
             pad_geoms,
             extra_pad_geoms,
             finger_geoms,
-            palm_geom: vec![geom("palm")?],
+            palm_geom: vec![palm],
             hand_geoms,
             object_geoms,
             object_body,
@@ -220,6 +261,8 @@ impl SceneModel {
             tendon_elastic: id(m, mjOBJ_TENDON, "tendon", "tendon_elastic")?,
             tendon_maxwell: id(m, mjOBJ_TENDON, "tendon", "tendon_maxwell")?,
             pad_touch_adr: m.sensor_adr()[touch] as usize,
+            produce,
+            geom_shapes,
         })
     }
 
@@ -274,6 +317,24 @@ impl SceneModel {
     pub fn xml(&self) -> &str {
         &self.xml
     }
+
+    /// The produce item and its flex's calibration, when the object is one.
+    pub fn produce(&self) -> Option<&ProducePart> {
+        self.produce.as_deref()
+    }
+}
+
+/// The geom a contact's other side is and the sign of its force on the flex `flex` (+1: the
+/// contact's normal points from that geom to the flex), for a contact between a geom and `flex`.
+fn flex_contact(c: &mujoco_rs::mujoco_c::mjContact, flex: usize) -> Option<(usize, f64)> {
+    let is = |k: usize| c.flex[k] >= 0 && c.flex[k] as usize == flex;
+    if is(1) && c.geom[0] >= 0 {
+        Some((c.geom[0] as usize, 1.0))
+    } else if is(0) && c.geom[1] >= 0 {
+        Some((c.geom[1] as usize, -1.0))
+    } else {
+        None
+    }
 }
 
 /// One MuJoCo simulation run on a shared [`SceneModel`]. Deterministic: the same inputs give a
@@ -294,6 +355,10 @@ pub struct Scene {
     step_start: Vec<f64>,
     /// Contacts per geom pair, when asked for ([`Physics::count_contacts`]).
     census: Option<ContactCensus>,
+    /// The produce item's damage, stem and start shape (`None` for a rigid object).
+    produce: Option<ProduceRun>,
+    /// The push on a produce item \[N\] (a rigid object's goes straight to its body).
+    produce_push_n: [f64; 3],
 }
 
 /// Armature of the arm joints in the kinematic mode [kg m^2]: large enough that a few newtons of
@@ -331,6 +396,10 @@ impl Scene {
             }
         }
         data.forward();
+        let produce = shared.ids.produce.as_ref().zip(shared.produce.as_ref()).map(|(ids, part)| {
+            let harvest = &shared.spec.produce;
+            ProduceRun::start(ids, &part.item, &data, harvest.harvest.then_some(harvest.stem_stiffness_n_m))
+        });
         let drive = Drive::new(&shared.spec.physics, &shared.spec.finger, q0);
         let payload_jacobian = vec![0.0; 3 * shared.model.ffi().nv as usize];
         Scene {
@@ -343,6 +412,8 @@ impl Scene {
             spare_data: None,
             step_start: Vec::new(),
             census: None,
+            produce,
+            produce_push_n: [0.0; 3],
         }
     }
 
@@ -449,16 +520,26 @@ impl Scene {
             }
         }
         let bound = self.shared.spec.physics.max_penetration_m;
+        if let (Some(run), Some(ids)) = (&self.produce, &self.shared.ids.produce)
+            && let Some(cause) = run.inverted(ids, &self.data)
+        {
+            return diverged(cause);
+        }
         for c in self.data.contact() {
             if c.dist < -bound {
-                let name = |g: i32| {
-                    self.shared.model.id_to_name(_mjtObjBase::mjOBJ_GEOM, g as usize).unwrap_or("?").to_string()
+                // A flex's side of a contact has no geom (-1): it is named by its flex.
+                let name = |k: usize| match (c.geom[k], c.flex[k]) {
+                    (g, _) if g >= 0 => {
+                        self.shared.model.id_to_name(_mjtObjBase::mjOBJ_GEOM, g as usize).unwrap_or("?").to_string()
+                    }
+                    (_, f) if f >= 0 => self
+                        .shared
+                        .model
+                        .id_to_name(_mjtObjBase::mjOBJ_FLEX, f as usize)
+                        .map_or_else(|| "a flex".to_string(), |n| format!("{n} (flex)")),
+                    _ => "?".to_string(),
                 };
-                return diverged(Divergence::Penetration {
-                    depth_m: -c.dist,
-                    geom1: name(c.geom1),
-                    geom2: name(c.geom2),
-                });
+                return diverged(Divergence::Penetration { depth_m: -c.dist, geom1: name(0), geom2: name(1) });
             }
         }
         // Kinetic energy of what is simulated (½ qvel' M qvel, M from the step's start), the
@@ -489,6 +570,33 @@ impl Scene {
             }
         }
         (sum, n)
+    }
+
+    /// Normal force \[N\] summed over contacts between a geom in `a` and the flex `flex`, and
+    /// their count.
+    fn normal_force_on_flex(&self, a: &[usize], flex: usize) -> (f64, usize) {
+        let mut sum = 0.0;
+        let mut n = 0;
+        for (i, c) in self.data.contact().iter().enumerate() {
+            if flex_contact(c, flex).is_some_and(|(g, _)| a.contains(&g)) && c.efc_address >= 0 {
+                sum += self.data.contact_force(i)[0];
+                n += 1;
+            }
+        }
+        (sum, n)
+    }
+
+    /// The upward (world +z) component of the contact forces geoms `a` exert on the flex `flex` \[N\].
+    fn vertical_force_on_flex(&self, a: &[usize], flex: usize) -> f64 {
+        let mut up = 0.0;
+        for (i, c) in self.data.contact().iter().enumerate() {
+            let Some((g, sign)) = flex_contact(c, flex) else { continue };
+            if a.contains(&g) && c.efc_address >= 0 {
+                let f = self.data.contact_force(i);
+                up += sign * (f[0] * c.frame[2] + f[1] * c.frame[5] + f[2] * c.frame[8]);
+            }
+        }
+        up
     }
 
     /// The upward (world +z) component of the contact forces geoms `a` exert on geoms `b` \[N\].
@@ -538,6 +646,37 @@ impl Scene {
     /// Geom ids of the object.
     pub fn object_geoms(&self) -> &[usize] {
         &self.shared.ids.object_geoms
+    }
+
+    /// The area of the finger's faces that touch the object now \[m²\]: each box of the finger
+    /// (a strip link, a pad's casing) in contact with the object counts with its largest face
+    /// (its length by the strip's width), once however many points touch. The area the wrap lies
+    /// on, at the links' resolution; a pad's bump counts through its casing.
+    pub fn contact_area_m2(&self) -> f64 {
+        let ids = &self.shared.ids;
+        let m = &self.shared.model;
+        let mut touching: Vec<usize> = Vec::new();
+        for c in self.data.contact() {
+            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+            let finger = if ids.object_geoms.contains(&g2) { g1 } else { g2 };
+            let object = if finger == g1 { g2 } else { g1 };
+            if c.efc_address >= 0 && ids.object_geoms.contains(&object) && ids.finger_geoms.contains(&finger) {
+                // The bump touches for its casing: one face per pad.
+                let face = if ids.pad_geoms.contains(&finger) { ids.pad_geoms[0] } else { finger };
+                if !touching.contains(&face) {
+                    touching.push(face);
+                }
+            }
+        }
+        touching
+            .into_iter()
+            .filter(|&g| m.geom_type()[g] == mujoco_rs::mujoco_c::_mjtGeomBase::mjGEOM_BOX)
+            .map(|g| {
+                let mut half = m.geom_size()[g];
+                half.sort_by(f64::total_cmp);
+                4.0 * half[1] * half[2]
+            })
+            .sum()
     }
 }
 
@@ -610,11 +749,19 @@ impl Physics for Scene {
                 self.compensate_payload();
             }
         }
+        if let (Some(run), Some(ids)) = (self.produce.as_mut(), &self.shared.ids.produce) {
+            run.apply_forces(ids, &mut self.data, t0, self.produce_push_n);
+        }
         // After the inputs are set (the payload compensation reads this data's last kinematics),
         // so that a switch of model carries them over with the state.
         self.mj_step();
         if let Some(census) = self.census.as_mut() {
             census.record(&self.data, t0 + dt);
+        }
+        if let (Some(run), Some(ids), Some(part)) =
+            (self.produce.as_mut(), &self.shared.ids.produce, &self.shared.produce)
+        {
+            run.record_damage(ids, &part.item, &self.shared.ids.geom_shapes, &self.data, dt);
         }
         self.check(t0 + dt)
     }
@@ -627,7 +774,19 @@ impl Physics for Scene {
         self.census.clone()
     }
 
+    fn contact_area_m2(&self) -> Option<f64> {
+        Some(Scene::contact_area_m2(self))
+    }
+
     fn set_object_force(&mut self, force_n: [f64; 3]) -> Result<(), PhysicsError> {
+        if self.produce.is_some() {
+            if let Some(bad) = force_n.iter().find(|f| !f.is_finite()) {
+                return Err(PhysicsError::BadInput { what: "object push force", value: *bad });
+            }
+            // Shared by the flex's nodes in proportion to their mass (Scene::step applies it).
+            self.produce_push_n = force_n;
+            return Ok(());
+        }
         let Some(body) = self.shared.ids.object_body else {
             return Err(PhysicsError::Config {
                 key: "disturbance.push".into(),
@@ -645,14 +804,22 @@ impl Physics for Scene {
     fn readout(&self) -> PhysicsReadout {
         let ids = &self.shared.ids;
         let qpos = self.data.qpos();
-        let (pad_force_n, _) = self.normal_force_between(&ids.pad_geoms, &ids.object_geoms);
+        // A geom set's normal force on the object (a rigid body's geoms, or a produce item's flex).
+        let on_object = |a: &[usize]| match &ids.produce {
+            Some(p) => self.normal_force_on_flex(a, p.flex),
+            None => self.normal_force_between(a, &ids.object_geoms),
+        };
+        let (pad_force_n, _) = on_object(&ids.pad_geoms);
         let mut extra_pad_forces_n = PerPad::filled(ids.extra_pad_geoms.len(), 0.0);
         for (f, geoms) in extra_pad_forces_n.as_mut_slice().iter_mut().zip(&ids.extra_pad_geoms) {
-            *f = self.normal_force_between(geoms, &ids.object_geoms).0;
+            *f = on_object(geoms).0;
         }
-        let (grip_force_n, grip_contacts) = self.normal_force_between(&ids.finger_geoms, &ids.object_geoms);
-        let (palm_force_n, _) = self.normal_force_between(&ids.palm_geom, &ids.object_geoms);
-        let tool_load_n = Some(self.vertical_force_on(&ids.hand_geoms, &ids.object_geoms));
+        let (grip_force_n, grip_contacts) = on_object(&ids.finger_geoms);
+        let (palm_force_n, _) = on_object(&ids.palm_geom);
+        let tool_load_n = Some(match &ids.produce {
+            Some(p) => self.vertical_force_on_flex(&ids.hand_geoms, p.flex),
+            None => self.vertical_force_on(&ids.hand_geoms, &ids.object_geoms),
+        });
         let hand_p = Vector3::from(self.data.xpos()[ids.hand_body]);
         let hq = self.data.xquat()[ids.hand_body];
         let hand_rot = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(hq[0], hq[1], hq[2], hq[3]));
@@ -678,6 +845,22 @@ impl Physics for Scene {
             },
             ..PhysicsReadout::default()
         };
+        if let (Some(p), Some(run), Some(part)) = (&ids.produce, &self.produce, &self.shared.produce) {
+            let centre = produce_run::centroid(p, &self.data);
+            let v = produce_run::velocity(p, &self.data);
+            let vh = self.data.object_velocity(_mjtObjBase::mjOBJ_BODY, ids.hand_body, false);
+            let w_hand = Vector3::new(vh[0], vh[1], vh[2]);
+            let v_obj = Vector3::from(v);
+            let in_hand = grip_in_hand(&hand, Vector3::new(vh[3], vh[4], vh[5]), w_hand, Vector3::from(centre), v_obj);
+            // The footprint centre, as a rigid object's body origin: the item's centre less its height.
+            r.object_pos_m = [centre[0], centre[1], centre[2] - part.item.radii_m[2]];
+            r.object_quat = [1.0, 0.0, 0.0, 0.0];
+            r.object_vel_m_s = v;
+            r.slip_speed_m_s = in_hand.slip_speed_m_s;
+            r.object_in_hand_m = in_hand.position_m;
+            let bump_force_n = self.normal_force_on_flex(&ids.pad_geoms[1..2], p.flex).0;
+            r.produce = Some(produce_run::ProduceReadout { bump_force_n, ..run.readout() });
+        }
         if let (Some(body), Some(grip)) = (ids.object_body, ids.object_grip) {
             r.object_pos_m = self.data.xpos()[body];
             r.object_quat = self.data.xquat()[body];

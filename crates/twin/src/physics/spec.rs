@@ -1,6 +1,7 @@
 //! [`SceneSpec`]: what a scene holds and how it is simulated.
 
 use super::config::{FingerConfig, ObjectConfig, PhysicsConfig};
+use super::produce_config::ProduceConfig;
 use tendril_config::{Checker, Validate};
 use tendril_ur5e::kinematics as ur5e;
 
@@ -36,6 +37,9 @@ pub struct SceneSpec {
     /// Start joint angles of the arm \[rad\]. The object is placed where the grown finger wraps it in
     /// this pose (see [`super::compose::placement`]).
     pub arm_q0: [f64; 6],
+    /// A produce item's overrides, its harvest and its flex's numerics (`[produce]`; read only when
+    /// the object is a produce item, [`super::produce`]).
+    pub produce: ProduceConfig,
 }
 
 impl Default for SceneSpec {
@@ -46,6 +50,7 @@ impl Default for SceneSpec {
             object: Some(ObjectConfig::default()),
             extra_pads: Vec::new(),
             arm_q0: ur5e::HOME,
+            produce: ProduceConfig::default(),
         }
     }
 }
@@ -57,6 +62,7 @@ impl Validate for SceneSpec {
         if let Some(o) = &self.object {
             at.section("object", o);
         }
+        at.section("produce", &self.produce);
         for (i, q) in self.arm_q0.iter().enumerate() {
             at.finite(&format!("arm_q0[{i}]"), *q);
         }
