@@ -287,11 +287,12 @@ fn a_full_disk_mid_sweep_loses_nothing_and_resume_completes_it() {
     )
     .unwrap();
     let out_dir = dir.path().join("out");
-    // 1 KiB: the header and a few rows fit, the sweep's six do not.
+    // 2.5 KiB: the header (about 1.1 KiB) and a few rows (about 0.4 KiB each) fit, the sweep's
+    // six do not.
     let limited = Command::new("sh")
         .arg("-c")
         .arg(format!(
-            "trap '' XFSZ; ulimit -f 2; exec '{}' sweep '{}' --out '{}' --threads 1",
+            "trap '' XFSZ; ulimit -f 5; exec '{}' sweep '{}' --out '{}' --threads 1",
             env!("CARGO_BIN_EXE_tendril"),
             sweep.display(),
             out_dir.display()
