@@ -10,9 +10,7 @@ use crate::common::cli::{stderr, tendril};
 type Rows = Vec<HashMap<String, String>>;
 
 fn read(path: &Path) -> Rows {
-    let mut r = csv::Reader::from_path(path).unwrap();
-    let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
-    r.records().map(|rec| header.iter().cloned().zip(rec.unwrap().iter().map(str::to_string)).collect()).collect()
+    crate::common::table::read_rows(path)
 }
 
 /// A numeric cell: a number, or empty for none; anything else fails the test.

@@ -145,9 +145,7 @@ fn bad_cycle_settings_are_refused_by_key() {
 }
 
 fn read(path: &Path) -> Vec<HashMap<String, String>> {
-    let mut r = csv::Reader::from_path(path).unwrap();
-    let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
-    r.records().map(|rec| header.iter().cloned().zip(rec.unwrap().iter().map(str::to_string)).collect()).collect()
+    crate::common::table::read_rows(path)
 }
 
 #[test]

@@ -5,6 +5,7 @@
 
 pub mod cli;
 pub mod phases;
+pub mod table;
 
 use tendril_run::scenario::PickPlaceScenario;
 

@@ -583,6 +583,21 @@ mod tests {
     use crate::pid::{Pid, PidConfig};
     use tendril_fbg::signals::Wavelengths;
 
+    /// The state a toy plant's cell reads at `time_s`: the arm at `arm_q`, the twine motor at
+    /// `twine_motor_rad`, the sensor's wavelengths at rest (the toy plants hand the force over
+    /// directly).
+    fn toy_state(time_s: f64, arm_q: [f64; ARM_JOINTS], twine_motor_rad: f64) -> CellState {
+        CellState {
+            time_s,
+            arm_q,
+            growth_motor_rad: 0.0,
+            twine_motor_rad,
+            wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
+            array: Default::default(),
+            tool_load_n: None,
+        }
+    }
+
     /// A toy plant: force grows linearly with twine past first contact at 60°, and relaxes by
     /// `creep_n_s` per second; returns (phases seen in order, final twine °, force trace).
     fn run_toy(feedback: bool, creep_n_s: f64) -> (Vec<Phase>, Vec<(f64, Phase, f64)>) {
@@ -609,15 +624,7 @@ mod tests {
         for i in 0..10_000 {
             let t = i as f64 * dt;
             let force = (0.02 * (twine_deg - 60.0) - offset).max(0.0);
-            let state = CellState {
-                time_s: t,
-                arm_q,
-                growth_motor_rad: 0.0,
-                twine_motor_rad: twine_deg.to_radians(),
-                wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
-                array: Default::default(),
-                tool_load_n: None,
-            };
+            let state = toy_state(t, arm_q, twine_deg.to_radians());
             let d = seq.update(&state, force, dt);
             if phases.last() != Some(&d.phase) {
                 phases.push(d.phase);
@@ -655,15 +662,7 @@ mod tests {
         for i in 0..ticks {
             let t = i as f64 * dt;
             let force = (0.02 * (twine_deg - 60.0) - creep).max(0.0);
-            let state = CellState {
-                time_s: t,
-                arm_q,
-                growth_motor_rad: 0.0,
-                twine_motor_rad: twine_deg.to_radians(),
-                wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
-                array: Default::default(),
-                tool_load_n: None,
-            };
+            let state = toy_state(t, arm_q, twine_deg.to_radians());
             let d = seq.update(&state, force, dt);
             trace.push((t, d.phase, force, twine_deg, d.setpoint_n));
             twine_deg = d.command.twine_motor_rad.to_degrees();
@@ -739,15 +738,7 @@ mod tests {
         let (dt, mut twine_deg, mut creep) = (0.01, 0.0_f64, 0.0);
         for i in 0..20_000 {
             let force = (0.02 * (twine_deg - 60.0) - creep).max(0.0);
-            let state = CellState {
-                time_s: i as f64 * dt,
-                arm_q: [0.0; ARM_JOINTS],
-                growth_motor_rad: 0.0,
-                twine_motor_rad: twine_deg.to_radians(),
-                wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
-                array: Default::default(),
-                tool_load_n: None,
-            };
+            let state = toy_state(i as f64 * dt, [0.0; ARM_JOINTS], twine_deg.to_radians());
             let d = seq.update(&state, force, dt);
             twine_deg = d.command.twine_motor_rad.to_degrees();
             creep += 0.05 * force * dt;
@@ -857,15 +848,7 @@ mod tests {
         let task = TaskConfig { minimum_durations: false, ..TaskConfig::default() };
         let mut seq = TaskSequencer::new(task, GripperConfig::default(), Box::new(Spy(seen.clone())), 1.0, true);
         seq.enter(Phase::Grasp, 0.0, radians(&TaskConfig::default().home_deg));
-        let state = CellState {
-            time_s: 5.0,
-            arm_q: [0.0; ARM_JOINTS],
-            growth_motor_rad: 0.0,
-            twine_motor_rad: 0.0,
-            wavelengths: Wavelengths { fbg1_nm: 1540.0, fbg2_nm: 1550.0 },
-            array: Default::default(),
-            tool_load_n: None,
-        };
+        let state = toy_state(5.0, [0.0; ARM_JOINTS], 0.0);
         seq.update(&state, 0.5, 0.01);
         let (phase, outlook) = seen.lock().unwrap()[0];
         assert_eq!(phase, Phase::Grasp);
