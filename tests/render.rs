@@ -66,14 +66,52 @@ fn scene_difference(a: &[u8], b: &[u8]) -> f64 {
     a[..n].iter().zip(&b[..n]).map(|(x, y)| f64::from(x.abs_diff(*y))).sum::<f64>() / n as f64
 }
 
+/// Whether a pixel is of the crimper's red handle (rgba 0.8 0.1 0.1), lit or in shade.
+fn is_red(p: &[u8], at: usize) -> bool {
+    let (r, g, b) = (i32::from(p[at]), i32::from(p[at + 1]), i32::from(p[at + 2]));
+    r > 90 && r > 2 * g + 30 && r > 2 * b + 30
+}
+
+/// Number of the object's red pixels in the scene part of a picture.
+fn red_pixels(p: &[u8]) -> usize {
+    (0..WIDTH * HEIGHT).filter(|&i| is_red(p, i * 3)).count()
+}
+
+/// The task's phases in the run's `trace.csv`, each with its first and last row's time \[s\].
+fn phase_spans(run_dir: &Path) -> Vec<(String, f64, f64)> {
+    let trace = std::fs::read_to_string(run_dir.join("trace.csv")).unwrap();
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let (time, phase) =
+        (header.iter().position(|c| *c == "time_s").unwrap(), header.iter().position(|c| *c == "phase").unwrap());
+    let mut spans: Vec<(String, f64, f64)> = Vec::new();
+    for line in trace.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let t: f64 = f[time].parse().unwrap();
+        match spans.last_mut() {
+            Some(last) if last.0 == f[phase] => last.2 = t,
+            _ => spans.push((f[phase].to_string(), t, t)),
+        }
+    }
+    spans
+}
+
+/// Renders `run_dir` with `camera` at the test's size and rate, without the force panel, and
+/// decodes the pictures.
+fn render_with(run_dir: &Path, camera: &str, video: &Path) -> Vec<Vec<u8>> {
+    let (w, h, fps) = (WIDTH.to_string(), HEIGHT.to_string(), FPS.to_string());
+    let run = run_dir.to_str().unwrap();
+    let args = ["render", run, "--out", video.to_str().unwrap(), "--width", &w, "--height", &h, "--fps", &fps];
+    let render = tendril(&[&args[..], &["--no-panel", "--camera", camera]].concat());
+    assert!(render.status.success(), "tendril render --camera {camera} failed: {}", stderr(&render));
+    decode(video).0
+}
+
 /// Mean row of the object's red pixels in the scene part (`None` if there are too few).
 fn red_row(p: &[u8]) -> Option<f64> {
     let (mut sum, mut n) = (0.0, 0);
     for row in 0..HEIGHT {
         for col in 0..WIDTH {
-            let at = (row * WIDTH + col) * 3;
-            let (r, g, b) = (i32::from(p[at]), i32::from(p[at + 1]), i32::from(p[at + 2]));
-            if r > 90 && r > 2 * g + 30 && r > 2 * b + 30 {
+            if is_red(p, (row * WIDTH + col) * 3) {
                 sum += row as f64;
                 n += 1;
             }
@@ -102,6 +140,9 @@ fn a_run_renders_to_a_video_that_shows_the_lift() {
         &h,
         "--fps",
         &fps,
+        // The object rises in a fixed camera's picture (the tracking camera follows it up).
+        "--camera",
+        "fixed",
     ]);
     assert!(
         render.status.success(),
@@ -139,6 +180,57 @@ fn a_run_renders_to_a_video_that_shows_the_lift() {
     // The object (red) rises in the picture: its pixels' mean row goes up by a few pixels.
     let (before, after) = (red_row(&pictures[first]).unwrap(), red_row(&pictures[final_]).unwrap());
     assert!(after < before - 3.0, "the object did not rise in the picture: row {before:.1} -> {after:.1}");
+}
+
+/// The crimper's task shortened (a 2 s grasp, 3 s moves), every phase kept: the transfer swings
+/// the arm 60° about its base, carrying the object about 0.4 m.
+const SHORT_TASK: [&str; 10] = [
+    "--set",
+    "task.grasp_s=2",
+    "--set",
+    "task.lift_s=3",
+    "--set",
+    "task.transfer_s=3",
+    "--set",
+    "task.lower_s=2",
+    "--set",
+    "task.release_s=1",
+];
+
+#[test]
+fn the_default_camera_keeps_the_object_in_view_in_every_phase_and_the_fixed_one_loses_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_dir = dir.path().join("run");
+    let run =
+        tendril(&[&["run", "scenarios/crimper.toml", "--out", run_dir.to_str().unwrap()], &SHORT_TASK[..]].concat());
+    assert!(run.status.success(), "run failed: {}", stderr(&run));
+    let spans = phase_spans(&run_dir);
+    let names: Vec<&str> = spans.iter().map(|s| s.0.as_str()).collect();
+    for phase in ["grow", "wrap", "grasp", "lift", "transfer", "lower", "release"] {
+        assert!(names.contains(&phase), "the run has no {phase} phase: {names:?}");
+    }
+
+    // The default camera (tracking): the handle is in the picture in every frame of every phase.
+    let tracking = render_with(&run_dir, "tracking", &dir.path().join("tracking.mp4"));
+    for (phase, start, end) in &spans {
+        let frames = (start * FPS).ceil() as usize..=((end * FPS).floor() as usize).min(tracking.len() - 1);
+        for k in frames {
+            let n = red_pixels(&tracking[k]);
+            assert!(n >= 40, "{phase}, t = {:.1} s: {n} pixels of the object in view", k as f64 / FPS);
+        }
+    }
+
+    // The fixed camera, aimed at the object's start, loses it during the transfer.
+    let fixed = render_with(&run_dir, "fixed", &dir.path().join("fixed.mp4"));
+    let (_, start, end) = spans.iter().find(|s| s.0 == "transfer").unwrap();
+    let lost = ((start * FPS).ceil() as usize..=(end * FPS).floor() as usize).filter(|&k| red_pixels(&fixed[k]) == 0);
+    assert!(lost.count() >= 5, "the fixed camera kept the object in view through the transfer");
+
+    // A camera the model lacks is an error naming the choices.
+    let out = tendril(&["render", run_dir.to_str().unwrap(), "--camera", "ceiling"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("--camera ceiling") && err.contains("tracking, fixed, hand"), "{err}");
 }
 
 #[test]

@@ -56,9 +56,12 @@ Domain randomisation
 
 Render
     ``render_mode="rgb_array"``: ``render()`` returns the scene as MuJoCo's offscreen renderer
-    draws it (as ``tendril render`` does: the free camera on the object, the pad in orange, the
-    contact forces as arrows), a ``(render_height, render_width, 3)`` uint8 array. It needs an
-    EGL driver (Mesa's ``libegl1 libgl1-mesa-dri`` on Debian/Ubuntu).
+    draws it (as ``tendril render`` does: the pad in orange, the contact forces as arrows), a
+    ``(render_height, render_width, 3)`` uint8 array. ``render_camera`` chooses the camera as
+    ``tendril render --camera`` does: ``"tracking"`` (the default) follows the object through every
+    phase, ``"fixed"`` stays aimed at its start, ``"hand"`` looks along the tool from the hand, or
+    the name of a camera in the scene's model. It needs an EGL driver (Mesa's
+    ``libegl1 libgl1-mesa-dri`` on Debian/Ubuntu).
 
 Vector
     ``gymnasium.make_vec("tendril/Grip-v0", num_envs=N)`` makes a
@@ -119,6 +122,7 @@ class GripEnv(gymnasium.Env):
         render_mode=None,
         render_width=640,
         render_height=480,
+        render_camera="tracking",
         models=None,
         randomize=None,
     ):
@@ -126,6 +130,7 @@ class GripEnv(gymnasium.Env):
             raise ValueError(f"render_mode: expected None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
         self._render_size = (int(render_width), int(render_height))
+        self._render_camera = str(render_camera)
         self._renderer = None
         self._last_frame = None
         self._path = os.fspath(scenario) if scenario is not None else DEFAULT_SCENARIO
@@ -189,7 +194,7 @@ class GripEnv(gymnasium.Env):
             return self._last_frame
         if self._renderer is None or not self._renderer.draws(self._session):
             width, height = self._render_size
-            self._renderer = Renderer(self._session, width=width, height=height)
+            self._renderer = Renderer(self._session, width=width, height=height, camera=self._render_camera)
         rgb = self._renderer.render(self._session)
         if rgb is not None:
             width, height = self._render_size

@@ -97,6 +97,40 @@ def test_rgb_array_renders_the_scene():
         GripEnv(render_mode="human")
 
 
+def test_the_render_camera_follows_the_object_or_stays_and_a_wrong_one_is_named():
+    def frames(camera):
+        env = GripEnv(SHORT_LIFT, render_mode="rgb_array", render_width=160, render_height=120, render_camera=camera)
+        env.reset(seed=1)
+        first = env.render().copy()
+        for _ in range(900):  # past the grasp into the lift
+            if any(env.step(np.array([0.3], dtype=np.float32))[2:4]):
+                break
+        last = env.render().copy()
+        env.close()
+        return first, last
+
+    def red(frame):  # the crimper's red handle
+        r, g, b = (frame[..., k].astype(int) for k in range(3))
+        return (r > 90) & (r > 2 * g + 30) & (r > 2 * b + 30)
+
+    def mean_row(frame):
+        return np.nonzero(red(frame))[0].mean()
+
+    tracking, fixed = frames("tracking"), frames("fixed")
+    np.testing.assert_array_equal(tracking[0], fixed[0])  # both start aimed at the object
+    # The lift raises the object in the fixed camera's picture; the tracking camera keeps it in
+    # place (within its follow's lag).
+    assert mean_row(fixed[1]) < mean_row(fixed[0]) - 3
+    assert abs(mean_row(tracking[1]) - mean_row(tracking[0])) < abs(mean_row(fixed[1]) - mean_row(fixed[0]))
+    hand = frames("hand")[1]
+    assert red(hand).sum() > 100  # the hand's camera looks at the handle
+    env = GripEnv(SHORT_LIFT, render_mode="rgb_array", render_width=160, render_height=120, render_camera="ceiling")
+    env.reset(seed=1)
+    with pytest.raises(RuntimeError, match="camera ceiling.*tracking, fixed, hand"):
+        env.render()
+    env.close()
+
+
 def test_the_reward_ranks_a_grip_at_the_setpoint_above_a_hard_squeeze():
     def episode(gain):
         env = GripEnv(SHORT_LIFT)

@@ -24,17 +24,18 @@ pub struct RenderArgs {
     /// Cell seconds per video second (2: twice as fast as the cell ran).
     #[arg(long, default_value_t = 1.0)]
     speed: f64,
-    /// A camera of the scene's model by name [default: a free camera on the object's start
-    /// position].
-    #[arg(long)]
-    camera: Option<String>,
-    /// Free camera: distance from the object [m].
+    /// The camera: `tracking` follows the object through every phase, `fixed` stays aimed at its
+    /// start, `hand` looks along the tool from the hand, or the name of a camera in the scene's
+    /// model.
+    #[arg(long, default_value = "tracking")]
+    camera: String,
+    /// Tracking and fixed camera: distance from the object [m].
     #[arg(long, default_value_t = 0.35)]
     distance: f64,
-    /// Free camera: azimuth [°].
+    /// Tracking and fixed camera: azimuth [°].
     #[arg(long, default_value_t = 135.0, allow_negative_numbers = true)]
     azimuth: f64,
-    /// Free camera: elevation [°] (negative looks down).
+    /// Tracking and fixed camera: elevation [°] (negative looks down).
     #[arg(long, default_value_t = -20.0, allow_negative_numbers = true)]
     elevation: f64,
     /// Leave out the force panel under the picture.
@@ -53,7 +54,7 @@ pub fn run(a: RenderArgs) -> anyhow::Result<ExitCode> {
         width: a.width,
         height: a.height,
         speed: a.speed,
-        camera: a.camera.clone(),
+        camera: tendril_render::Camera::parse(&a.camera),
         distance_m: a.distance,
         azimuth_deg: a.azimuth,
         elevation_deg: a.elevation,

@@ -15,7 +15,7 @@ pub mod overlay;
 pub mod video;
 
 use std::path::{Path, PathBuf};
-use tendril_render::{SceneRenderer, View};
+use tendril_render::{Camera, SceneRenderer, View};
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_twin::frames::{self, FRAMES_FILE, FrameLog, Snapshot};
 use tendril_twin::physics::SceneModel;
@@ -35,13 +35,14 @@ pub struct RenderOptions {
     pub height: u32,
     /// Cell seconds per video second (2: twice as fast as the cell ran).
     pub speed: f64,
-    /// A camera of the model by name; `None`: a free camera on the object's start position.
-    pub camera: Option<String>,
-    /// Free camera: distance from the object \[m\].
+    /// The camera: tracking the object (the default), fixed on its start, the hand's or one of
+    /// the model's.
+    pub camera: Camera,
+    /// Tracking and fixed camera: distance from the object \[m\].
     pub distance_m: f64,
-    /// Free camera: azimuth \[°\].
+    /// Tracking and fixed camera: azimuth \[°\].
     pub azimuth_deg: f64,
-    /// Free camera: elevation \[°\] (negative: from above).
+    /// Tracking and fixed camera: elevation \[°\] (negative: from above).
     pub elevation_deg: f64,
     /// Draw the force panel under the picture.
     pub panel: bool,
@@ -58,7 +59,7 @@ impl Default for RenderOptions {
             width: 640,
             height: 480,
             speed: 1.0,
-            camera: None,
+            camera: Camera::Tracking,
             distance_m: 0.35,
             azimuth_deg: 135.0,
             elevation_deg: -20.0,
@@ -165,10 +166,8 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
         // model, but MuJoCo's contact solve at rapier's penetrations is not rapier's force: left out there.
         contact_forces: scenario.scene_spec().physics.backend == tendril_twin::physics::Backend::Mujoco,
     };
-    let mut renderer = SceneRenderer::new(&scene, &view).map_err(|e| match &opts.camera {
-        Some(_) if e.to_string().starts_with("camera ") => anyhow::anyhow!("--{e}"),
-        _ => e,
-    })?;
+    let mut renderer = SceneRenderer::new(&scene, &view)
+        .map_err(|e| if e.to_string().starts_with("camera ") { anyhow::anyhow!("--{e}") } else { e })?;
     let [nq, nv, nu, na] = renderer.state_sizes();
     let sizes = frames::StateSizes { nq, nv, nu, na };
     if sizes != log.sizes {
@@ -196,7 +195,7 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<Render
     for k in 0..n {
         let t = (k as f64 * opts.speed / opts.fps).min(cell_s);
         let state = frame_state(&log, nearest(&log.times, t));
-        let rgb = renderer.render(&state).map_err(|e| e.context(format!("frame {k}")))?;
+        let rgb = renderer.render(&state, t).map_err(|e| e.context(format!("frame {k}")))?;
         picture[..rgb.len()].copy_from_slice(rgb);
         if let Some(p) = panel.as_mut() {
             p.draw(t, &mut picture[rgb.len()..])?;

@@ -326,8 +326,10 @@ impl Cell for LiveCell {
 pub const CAMERA_DISTANCE_M: f64 = 0.6;
 
 /// The model the viewer draws: the sim's, with its free camera on the object's grip at the start
-/// (from 135° azimuth, 20° above, as `tendril render`), a brighter headlight and the sensor pad in
-/// orange. Only what the viewer draws differs; the sim keeps its own model.
+/// (from 135° azimuth, 20° above, as `tendril render`) and dressed as `tendril render` dresses it
+/// ([`tendril_render::dress_for_screen`]). Only what the viewer draws differs; the sim keeps its
+/// own model. mujoco-rs's viewer gives no handle on its camera after it opens, so the camera cannot
+/// follow the task by itself: its side panel's camera menu can track a body.
 fn viewer_model(sim: &SimCell) -> mujoco_rs::prelude::MjModel {
     let shared = sim.model();
     let start = tendril_twin::physics::Scene::new(shared.clone());

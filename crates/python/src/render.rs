@@ -5,11 +5,12 @@ use crate::session::Session;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::sync::Arc;
-use tendril_render::{SceneRenderer, View};
+use tendril_render::{Camera, SceneRenderer, View};
 use tendril_twin::physics::SceneModel;
 
 /// Draws a session's scene offscreen (MuJoCo's renderer through EGL), as `tendril render` draws
-/// a recorded run: the free camera on the object, the pad in orange, the contact forces as arrows.
+/// a recorded run: by default the tracking camera on the object, the pad in orange, the contact
+/// forces as arrows.
 /// Holds an OpenGL context: use it from the thread that made it.
 #[pyclass(unsendable, module = "tendril._native")]
 pub struct Renderer {
@@ -21,22 +22,25 @@ pub struct Renderer {
 
 #[pymethods]
 impl Renderer {
-    /// A renderer for `session`'s scene: `width` × `height` pixels, a camera of the model by name
-    /// or the free camera `distance_m` from the object at `azimuth_deg` and `elevation_deg`.
-    /// Raises `RuntimeError` when the machine has no EGL driver (saying what to install) or the
-    /// camera does not exist (naming those that do).
+    /// A renderer for `session`'s scene: `width` × `height` pixels, seen by `camera`: `"tracking"`
+    /// (following the object through every phase), `"fixed"` (aimed at its start), `"hand"` (along
+    /// the tool from the hand) or a camera of the model by name; the tracking and fixed cameras
+    /// stand `distance_m` from the object at `azimuth_deg` and `elevation_deg`. Raises
+    /// `RuntimeError` when the machine has no EGL driver (saying what to install) or the camera
+    /// does not exist (naming the choices).
     #[new]
-    #[pyo3(signature = (session, width = 640, height = 480, camera = None, distance_m = 0.35, azimuth_deg = 135.0, elevation_deg = -20.0))]
+    #[pyo3(signature = (session, width = 640, height = 480, camera = "tracking", distance_m = 0.35, azimuth_deg = 135.0, elevation_deg = -20.0))]
     fn new(
         session: &Session,
         width: u32,
         height: u32,
-        camera: Option<String>,
+        camera: &str,
         distance_m: f64,
         azimuth_deg: f64,
         elevation_deg: f64,
     ) -> PyResult<Renderer> {
         let scene = session.scene();
+        let camera = Camera::parse(camera);
         let view = View { width, height, camera, distance_m, azimuth_deg, elevation_deg, ..View::default() };
         let inner = SceneRenderer::new(&scene, &view).map_err(run_error)?;
         Ok(Renderer { inner, scene, width, height })
@@ -61,8 +65,8 @@ impl Renderer {
                 "this renderer was made for another scene: make a new one for this session"
             )));
         }
-        let Some(state) = session.snapshot() else { return Ok(None) };
-        let rgb = self.inner.render(&state).map_err(run_error)?;
+        let Some((state, time_s)) = session.snapshot() else { return Ok(None) };
+        let rgb = self.inner.render(&state, time_s).map_err(run_error)?;
         Ok(Some(PyBytes::new(py, rgb)))
     }
 }

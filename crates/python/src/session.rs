@@ -154,9 +154,13 @@ impl Session {
         self.scene.clone()
     }
 
-    /// The scene's current state (`None` once the run is over or when the physics keeps none).
-    pub fn snapshot(&self) -> Option<Snapshot> {
-        self.lock().session.as_ref().and_then(|s| s.cell().snapshot())
+    /// The scene's current state and the cell time of the last tick \[s\] (`None` once the run
+    /// is over or when the physics keeps none).
+    pub fn snapshot(&self) -> Option<(Snapshot, f64)> {
+        let state = self.lock();
+        let session = state.session.as_ref()?;
+        let time_s = session.rows().last().map_or(0.0, |r| r.time_s);
+        session.cell().snapshot().map(|s| (s, time_s))
     }
 
     /// One tick (without the GIL: the caller detaches).

@@ -1,6 +1,9 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+pub mod camera;
+
+pub use camera::{Camera, FOLLOW_TIME_S, Follow, HAND_CAMERA};
 use mujoco_rs::mujoco_c::{_mjtObjBase, mjtFrame, mjtJoint, mjtVisFlag};
 use mujoco_rs::prelude::{MjData, MjModel};
 use mujoco_rs::renderer::{MjRenderer, RendererError};
@@ -19,26 +22,26 @@ pub struct View {
     pub width: u32,
     /// Height of the picture \[px\], 16 to [`MAX_SIDE`].
     pub height: u32,
-    /// A camera of the model by name; `None`: the free camera on the object (below).
-    pub camera: Option<String>,
-    /// Free camera: distance from the object \[m\].
+    /// The camera: tracking (the default), fixed, the hand's or one of the model's.
+    pub camera: Camera,
+    /// Tracking and fixed camera: distance from the object \[m\].
     pub distance_m: f64,
-    /// Free camera: azimuth \[°\].
+    /// Tracking and fixed camera: azimuth \[°\].
     pub azimuth_deg: f64,
-    /// Free camera: elevation \[°\] (negative: from above).
+    /// Tracking and fixed camera: elevation \[°\] (negative: from above).
     pub elevation_deg: f64,
     /// Draw the contact forces as MuJoCo computes them for the state (arrows, 2 cm per newton).
     pub contact_forces: bool,
 }
 
 impl Default for View {
-    /// 640 × 480, the free camera 0.35 m from the object, from 135° and 20° above: the grip and
-    /// the finger around it fill the picture.
+    /// 640 × 480, the tracking camera 0.35 m from the object, from 135° and 20° above: the grip
+    /// and the finger around it fill the picture.
     fn default() -> Self {
         View {
             width: 640,
             height: 480,
-            camera: None,
+            camera: Camera::Tracking,
             distance_m: 0.35,
             azimuth_deg: 135.0,
             elevation_deg: -20.0,
@@ -73,15 +76,23 @@ pub struct SceneRenderer {
     model: Arc<MjModel>,
     data: MjData<Arc<MjModel>>,
     renderer: MjRenderer,
-    /// The free camera follows the object; a named camera stays where the model puts it.
-    free: bool,
+    camera: Camera,
+    /// The free camera's azimuth at the start \[°\].
+    azimuth_deg: f64,
+    /// The arm's base body (the root of the hand's tree), which the tracking camera turns about.
+    arm_base: usize,
+    /// The tracking camera's look-at point.
+    follow: Follow,
+    /// Bearing of the look-at point from the arm's base in the first state drawn \[°\].
+    start_bearing_deg: Option<f64>,
     /// Whether the free camera has been aimed (at the first rendered state).
     aimed: bool,
 }
 
 impl SceneRenderer {
     /// A renderer for `scene` as `view` says. Fails with what to install when the machine has no
-    /// EGL driver, and with the cameras the model has when `view.camera` names none of them.
+    /// EGL driver, and with the choices (the model's cameras among them) when `view.camera` names
+    /// a camera the model does not have.
     pub fn new(scene: &Arc<SceneModel>, view: &View) -> anyhow::Result<SceneRenderer> {
         view.check()?;
         // The run's model with what only the picture needs changed: the offscreen buffer's size,
@@ -98,8 +109,9 @@ impl SceneRenderer {
         dress_for_screen(&mut model, scene);
         let model = Arc::new(model);
         let camera = match &view.camera {
-            Some(name) => MjvCamera::new_fixed(camera_id(&model, name)?),
-            None => {
+            Camera::Hand => MjvCamera::new_fixed(camera_id(&model, HAND_CAMERA)?),
+            Camera::Model(name) => MjvCamera::new_fixed(camera_id(&model, name)?),
+            Camera::Tracking | Camera::Fixed => {
                 let mut cam = MjvCamera::new_free(&model);
                 cam.distance = view.distance_m;
                 cam.azimuth = view.azimuth_deg;
@@ -118,7 +130,19 @@ impl SceneRenderer {
             .build(&model)
             .map_err(|e| no_gl(&e))?;
         let data = MjData::new(model.clone());
-        Ok(SceneRenderer { scene: scene.clone(), model, data, renderer, free: view.camera.is_none(), aimed: false })
+        let arm_base = model.body_rootid()[scene.hand_body()] as usize;
+        Ok(SceneRenderer {
+            arm_base,
+            scene: scene.clone(),
+            model,
+            data,
+            renderer,
+            camera: view.camera.clone(),
+            azimuth_deg: view.azimuth_deg,
+            follow: Follow::new(FOLLOW_TIME_S),
+            start_bearing_deg: None,
+            aimed: false,
+        })
     }
 
     /// Numbers of `qpos`, `qvel`, `ctrl` and `act` values a state of this scene has.
@@ -127,10 +151,11 @@ impl SceneRenderer {
         [m.nq, m.nv, m.nu, m.na].map(|n| n as usize)
     }
 
-    /// Draws `state` and returns the picture: width × height × 3 bytes of RGB, the top row first.
-    /// The free camera is aimed at the object in the first state drawn and stays there (a video's
-    /// camera does not shake with the object).
-    pub fn render(&mut self, state: &Snapshot) -> anyhow::Result<&[u8]> {
+    /// Draws `state`, the scene at cell time `time_s` \[s\], and returns the picture: width ×
+    /// height × 3 bytes of RGB, the top row first. The tracking camera's look-at point follows the
+    /// object from one call to the next by the cell time between them ([`Follow`]); the fixed one
+    /// is aimed at the object in the first state drawn and stays there.
+    pub fn render(&mut self, state: &Snapshot, time_s: f64) -> anyhow::Result<&[u8]> {
         let sizes = self.state_sizes();
         let given = [state.qpos.len(), state.qvel.len(), state.ctrl.len(), state.act.len()];
         if given != sizes {
@@ -141,9 +166,25 @@ impl SceneRenderer {
         }
         self.set_state(state);
         self.data.forward();
-        if self.free && !self.aimed {
-            self.renderer.camera_mut().lookat = camera_target(&self.scene, &self.data);
-            self.aimed = true;
+        match self.camera {
+            Camera::Tracking => {
+                // The look-at point follows the object, and the camera turns about the arm's base
+                // as the object does: the view the arm gives at the start (the arm behind the
+                // object) stays, instead of the arm's links swinging between camera and object.
+                let lookat = self.follow.update(camera_target(&self.scene, &self.data), time_s);
+                let base = self.data.xpos()[self.arm_base];
+                let bearing = (lookat[1] - base[1]).atan2(lookat[0] - base[0]).to_degrees();
+                let start = *self.start_bearing_deg.get_or_insert(bearing);
+                let turned = (bearing - start + 540.0).rem_euclid(360.0) - 180.0;
+                let camera = self.renderer.camera_mut();
+                camera.lookat = lookat;
+                camera.azimuth = self.azimuth_deg + turned;
+            }
+            Camera::Fixed if !self.aimed => {
+                self.renderer.camera_mut().lookat = camera_target(&self.scene, &self.data);
+                self.aimed = true;
+            }
+            _ => {}
         }
         self.renderer.sync_data(&mut self.data).map_err(|e| anyhow::anyhow!("cannot render: {e}"))?;
         self.renderer.render().map_err(|e| anyhow::anyhow!("cannot render: {e}"))?;
@@ -174,12 +215,15 @@ impl SceneRenderer {
 }
 
 /// Dresses `model`, a copy of `scene`'s, for the screen as `tendril render` and `tendril view`
-/// show it: a brighter headlight (the scene's own lights leave the arm and the hand dark) and the
-/// sensor pad in orange.
+/// show it: the sensor pad in orange and, in a scene without lights of its own (no table, so no
+/// `models/table.xml` lights), a brighter headlight, as MuJoCo's default leaves the arm and the
+/// hand dark.
 pub fn dress_for_screen(model: &mut MjModel, scene: &SceneModel) {
-    let vis = model.vis_mut();
-    vis.headlight.ambient = [0.35, 0.35, 0.35];
-    vis.headlight.diffuse = [0.6, 0.6, 0.6];
+    if model.ffi().nlight == 0 {
+        let vis = model.vis_mut();
+        vis.headlight.ambient = [0.35, 0.35, 0.35];
+        vis.headlight.diffuse = [0.6, 0.6, 0.6];
+    }
     for &g in scene.pad_geoms() {
         model.geom_rgba_mut()[g] = [1.0, 0.45, 0.0, 1.0];
     }
@@ -194,16 +238,13 @@ pub fn camera_target(scene: &SceneModel, data: &MjData<Arc<MjModel>>) -> [f64; 3
     }
 }
 
-/// The id of the model's camera `name`, or an error listing the cameras it has.
+/// The id of the model's camera `name`, or an error listing the choices: tracking, fixed and the
+/// cameras the model has.
 fn camera_id(model: &MjModel, name: &str) -> anyhow::Result<usize> {
     model.name_to_id(_mjtObjBase::mjOBJ_CAMERA, name).ok_or_else(|| {
-        let names: Vec<&str> =
-            (0..model.ffi().ncam as usize).filter_map(|c| model.id_to_name(_mjtObjBase::mjOBJ_CAMERA, c)).collect();
-        anyhow::anyhow!(
-            "camera {name}: the scene has no such camera (it has: {}); leave the camera out for the \
-             free camera on the object",
-            if names.is_empty() { "none".to_string() } else { names.join(", ") }
-        )
+        let cameras = (0..model.ffi().ncam as usize).filter_map(|c| model.id_to_name(_mjtObjBase::mjOBJ_CAMERA, c));
+        let choices: Vec<&str> = ["tracking", "fixed"].into_iter().chain(cameras).collect();
+        anyhow::anyhow!("camera {name}: the scene has no such camera; the choices are {}", choices.join(", "))
     })
 }
 

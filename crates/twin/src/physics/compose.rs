@@ -253,12 +253,17 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement, Option<ProducePart>
     let mut tendon = String::new();
     let mut sensor = String::new();
     // The object's assets (meshes), with their files already made absolute by ObjectModel.
-    let asset = object.as_ref().map_or("", |o| section(&o.mjcf, "asset")).to_string();
+    let mut asset = object.as_ref().map_or("", |o| section(&o.mjcf, "asset")).to_string();
+    // How the scene looks (sky, the table's pattern, the headlight): table.xml's <asset> and
+    // <visual>, which only pictures use.
+    let mut visual = String::new();
 
     let mut produce = None;
     if spec.object.is_some() {
         let table = part(models, "table.xml")?.replace("pos=\"0 0 0\"", &format!("pos=\"0 0 {}\"", num(place.table_z)));
         worldbody.push_str(section(&table, "worldbody"));
+        asset.push_str(section(&table, "asset"));
+        visual.push_str(section(&table, "visual"));
         match (object.as_ref().and_then(|o| o.produce.as_ref()), place.object) {
             (Some(raw), Some(foot)) => {
                 let p = produce_part(spec, raw)?;
@@ -288,7 +293,7 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement, Option<ProducePart>
     sensor.push_str(section(&finger_doc, "sensor"));
 
     let xml = format!(
-        "<mujoco model=\"tendril_cell\">\n  {header}\n  <asset>{asset}</asset>\n  <worldbody>{worldbody}</worldbody>\n  \
+        "<mujoco model=\"tendril_cell\">\n  {header}\n  <visual>{visual}</visual>\n  <asset>{asset}</asset>\n  <worldbody>{worldbody}</worldbody>\n  \
          <tendon>{tendon}</tendon>\n  <actuator>{actuator}</actuator>\n  \
          <sensor>{sensor}</sensor>\n</mujoco>\n",
         header = header(&spec.physics),
