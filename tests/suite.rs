@@ -8,6 +8,7 @@
 
 mod common;
 
+mod adaptive_map;
 mod array_peaks;
 mod backend_rapier;
 mod bounded_inputs;

@@ -75,6 +75,15 @@ pub struct ChartArgs {
     /// Gain map: the Ki values \[(°/s)/(N·s)\] [default: 0,0.05,0.5,5,50; with --quick 0.05].
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     ki: Vec<f64>,
+    /// Gain map: run every STRIDE-th Kp and Ki first, then only the cells whose runs disagree,
+    /// down to every point; the rest is filled in from the cells (the CSV's `ran` says which).
+    /// 1 runs every point.
+    #[arg(long, default_value_t = crate::sweep::refine::DEFAULT_STRIDE, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
+    stride: usize,
+    /// Gain map: also refine where a summary field crosses a value, `FIELD=VALUE` (e.g.
+    /// `max_fluctuation_pct=10`); the CSV's `beyond_contour` says which side each point is on.
+    #[arg(long, value_name = "FIELD=VALUE")]
+    contour: Option<crate::sweep::contour::Contour>,
 }
 
 /// The three objects' scenarios, or the ones given.
@@ -112,7 +121,8 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
                 if a.quick { (&[5.0, 20.0], &[0.05]) } else { (&study::gain_map::KP, &study::gain_map::KI) };
             let kp = if a.kp.is_empty() { kp } else { &a.kp };
             let ki = if a.ki.is_empty() { ki } else { &a.ki };
-            study::gain_map::run(&scenarios, kp, ki, &a.set, &out, a.threads)?
+            let refinement = study::gain_map::Refinement { stride: a.stride, contour: a.contour.clone() };
+            study::gain_map::run(&scenarios, kp, ki, &a.set, &refinement, &out, a.threads)?
         }
         "controllers" => controllers(&a, &out)?,
         "placement" => {

@@ -1,6 +1,7 @@
 //! `tendril sweep` and `tendril merge`.
 
 use super::emit;
+use crate::sweep::adaptive::RefineOptions;
 use crate::sweep::execute::{SweepOptions, run_sweep};
 use crate::sweep::{Shard, load_sweep};
 use std::path::PathBuf;
@@ -30,6 +31,19 @@ pub struct SweepArgs {
     /// Keep each run's directory under runs/<id>/ (trace.csv, summary.json) with its rosbag2 bag in bag/.
     #[arg(long)]
     bag: bool,
+    /// Refine adaptively over two grid keys (`--refine controller.kp,controller.ki`): each map of
+    /// those two keys runs every STRIDE-th value of each first, then only the cells whose runs
+    /// disagree (outcome, oscillation, `--contour`), down to every point; `map.csv` holds every
+    /// point, run or filled in from its cell (column `ran`). Not with `--shard` or `--resume`.
+    #[arg(long, value_name = "KEY1,KEY2")]
+    refine: Option<String>,
+    /// With `--refine`: the coarse grid's stride (1 runs every point).
+    #[arg(long, default_value_t = crate::sweep::refine::DEFAULT_STRIDE, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
+    stride: usize,
+    /// With `--refine`: also follow where a summary field crosses a value, `FIELD=VALUE` (e.g.
+    /// `max_fluctuation_pct=10`).
+    #[arg(long, value_name = "FIELD=VALUE", requires = "refine")]
+    contour: Option<crate::sweep::contour::Contour>,
 }
 
 /// Most worker threads a sweep may ask for. Why: runs are CPU-bound and each holds its own
@@ -71,6 +85,17 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         shard: a.shard,
         resume: a.resume,
         bag: a.bag,
+        refine: match a.refine.as_deref().map(|k| k.split_once(',')) {
+            None => None,
+            Some(Some((x, y))) if !x.trim().is_empty() && !y.trim().is_empty() && !y.contains(',') => {
+                Some(RefineOptions {
+                    keys: [x.trim().to_string(), y.trim().to_string()],
+                    stride: a.stride,
+                    contour: a.contour.clone(),
+                })
+            }
+            Some(_) => anyhow::bail!("--refine {}: give two grid keys, KEY1,KEY2", a.refine.unwrap_or_default()),
+        },
     };
     // Ctrl-C, SIGTERM and SIGHUP: no new run starts; every finished row is kept whole.
     crate::signals::install_signal_handlers()?;
@@ -97,6 +122,14 @@ pub fn run(a: SweepArgs) -> anyhow::Result<ExitCode> {
         tendril_run::summary::speed_factor(stats.sim_time_s / stats.wall_time_s.max(1e-9)),
         stats.results.display()
     ));
+    if options.refine.is_some() && tendril_cell::interrupt::requested().is_none() {
+        emit(&format!(
+            "refined: {} of {} points run; every point in {}\n",
+            stats.ran,
+            stats.planned,
+            options.out_dir.join("map.csv").display()
+        ));
+    }
     Ok(super::exit_for_runs(stats.errors > 0))
 }
 

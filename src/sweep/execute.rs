@@ -24,6 +24,8 @@ pub struct SweepOptions {
     pub resume: bool,
     /// Keep each run's directory, `runs/<id>/` (trace, summary and its rosbag2 bag in `bag/`).
     pub bag: bool,
+    /// Refine adaptively over two grid keys instead of running every point (`--refine`).
+    pub refine: Option<super::adaptive::RefineOptions>,
 }
 
 /// The folder under a sweep's output where `--bag` keeps each run's directory.
@@ -125,10 +127,17 @@ fn execute_one(sweep: &Sweep, run: &SweepRun, models: &ModelCache, options: &Swe
     }
 }
 
-/// Runs the sweep. A run that fails is a row with outcome "error"; the sweep goes on.
+/// Runs the sweep. A run that fails is a row with outcome "error"; the sweep goes on. With
+/// `options.refine`, only the runs the adaptive maps need ([`super::adaptive`]), and `map.csv`.
 pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepStats> {
     let started = std::time::Instant::now();
     check_runs(sweep)?;
+    if options.refine.is_some() && (options.shard.is_some() || options.resume) {
+        anyhow::bail!(
+            "--refine chooses each run from the results of the runs before it, so it runs whole: \
+             leave out --shard and --resume"
+        );
+    }
     std::fs::create_dir_all(&options.out_dir)
         .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", options.out_dir.display()))?;
     let results = results_path(&options.out_dir, options.shard);
@@ -138,56 +147,120 @@ pub fn run_sweep(sweep: &Sweep, options: &SweepOptions) -> anyhow::Result<SweepS
     let done = opened.done;
     let mine: Vec<&SweepRun> = sweep.runs.iter().filter(|r| options.shard.is_none_or(|s| s.owns(r.id))).collect();
     let todo: Vec<&SweepRun> = mine.iter().copied().filter(|r| !done.contains(&r.id)).collect();
-    let writer = Mutex::new(file);
-    let progress = indicatif::ProgressBar::new(todo.len() as u64);
-    progress.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {per_sec}  ETA {eta}")
-            .expect("the template is valid"),
-    );
-    let models = ModelCache::default();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(options.threads.unwrap_or(0)).build()?;
-    // After a write error (a full disk) no further run starts: its row could not be kept.
-    let write_failed = std::sync::atomic::AtomicBool::new(false);
-    let outcomes: Vec<anyhow::Result<Option<(bool, f64)>>> = pool.install(|| {
-        todo.par_iter()
-            .map(|run| {
-                if tendril_cell::interrupt::requested().is_some()
-                    || write_failed.load(std::sync::atomic::Ordering::SeqCst)
-                {
-                    return Ok(None);
-                }
-                let summary = execute_one(sweep, run, &models, options);
-                // A run cut short by an operator stop is not done: no row, so --resume runs it.
-                if tendril_cell::interrupt::requested().is_some() {
-                    return Ok(None);
-                }
-                let cells = row(sweep, &id, run, &summary);
-                if let Err(e) = writer.lock().unwrap_or_else(|p| p.into_inner()).append(&cells) {
-                    write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
-                    return Err(e.into());
-                }
-                progress.inc(1);
-                Ok(Some((summary.outcome == "error", summary.sim_time_s)))
-            })
-            .collect()
-    });
-    progress.finish_and_clear();
+    let runner = Runner {
+        sweep,
+        options,
+        id: &id,
+        writer: Mutex::new(file),
+        models: ModelCache::default(),
+        pool: rayon::ThreadPoolBuilder::new().num_threads(options.threads.unwrap_or(0)).build()?,
+        write_failed: std::sync::atomic::AtomicBool::new(false),
+        finished: Mutex::new(Vec::new()),
+    };
+    let planned = match &options.refine {
+        None => {
+            // A stop by signal is not a failure: the rows made are kept and counted below.
+            if let Err(e) = runner.run(&todo)
+                && tendril_cell::interrupt::requested().is_none()
+            {
+                return Err(e);
+            }
+            mine.len()
+        }
+        Some(refine) => {
+            let outcome = super::adaptive::refine_sweep(sweep, &id, refine, |batch| runner.run(batch));
+            // A stop by signal ends the refinement between batches; the rows made are kept.
+            if tendril_cell::interrupt::requested().is_none() {
+                let (rows, _) = outcome?;
+                write_map(sweep, &options.out_dir, &rows)?;
+            }
+            sweep.runs.len()
+        }
+    };
+    let finished = runner.finished.into_inner().unwrap_or_else(|p| p.into_inner());
     let mut stats = SweepStats {
         results,
-        planned: mine.len(),
+        planned,
         skipped: mine.len() - todo.len(),
-        ran: 0,
-        errors: 0,
-        sim_time_s: 0.0,
+        ran: finished.len(),
+        errors: finished.iter().filter(|(error, _)| *error).count(),
+        sim_time_s: finished.iter().map(|(_, sim)| sim).sum(),
         wall_time_s: 0.0,
         dropped_tail: opened.dropped_tail,
     };
-    for o in outcomes {
-        let Some((error, sim)) = o? else { continue };
-        stats.ran += 1;
-        stats.errors += usize::from(error);
-        stats.sim_time_s += sim;
-    }
     stats.wall_time_s = started.elapsed().as_secs_f64();
     Ok(stats)
+}
+
+/// The adaptive map of every point of the sweep (`map.csv` beside `results.csv`), written whole.
+fn write_map(sweep: &Sweep, out_dir: &Path, rows: &[Vec<String>]) -> anyhow::Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut head = header(sweep, &[]);
+    head.extend(super::adaptive::MAP_COLUMNS.map(String::from));
+    w.write_record(&head)?;
+    for r in rows {
+        w.write_record(r)?;
+    }
+    let bytes = w.into_inner().map_err(|e| anyhow::anyhow!("map.csv: {e}"))?;
+    super::durable::write_atomically(&out_dir.join("map.csv"), &bytes)?;
+    Ok(())
+}
+
+/// Runs batches of a sweep's runs in parallel, appending each row as it finishes.
+struct Runner<'a> {
+    sweep: &'a Sweep,
+    options: &'a SweepOptions,
+    id: &'a str,
+    writer: Mutex<super::durable::ResultsFile>,
+    models: ModelCache,
+    pool: rayon::ThreadPool,
+    /// After a write error (a full disk) no further run starts: its row could not be kept.
+    write_failed: std::sync::atomic::AtomicBool,
+    /// Every run finished and written: whether it ended in "error", and its simulated seconds.
+    finished: Mutex<Vec<(bool, f64)>>,
+}
+
+impl Runner<'_> {
+    /// Runs `runs`, writing each row; their summaries in order, or the first write error. A run
+    /// cut short by an operator stop has no row (so `--resume` runs it), and then the batch
+    /// ends in an error saying so.
+    fn run(&self, runs: &[&SweepRun]) -> anyhow::Result<Vec<RunSummary>> {
+        use std::sync::atomic::Ordering::SeqCst;
+        let progress = indicatif::ProgressBar::new(runs.len() as u64);
+        progress.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {per_sec}  ETA {eta}")
+                .expect("the template is valid"),
+        );
+        let outcomes: Vec<anyhow::Result<Option<RunSummary>>> = self.pool.install(|| {
+            runs.par_iter()
+                .map(|run| {
+                    if tendril_cell::interrupt::requested().is_some() || self.write_failed.load(SeqCst) {
+                        return Ok(None);
+                    }
+                    let summary = execute_one(self.sweep, run, &self.models, self.options);
+                    if tendril_cell::interrupt::requested().is_some() {
+                        return Ok(None);
+                    }
+                    let cells = row(self.sweep, self.id, run, &summary);
+                    if let Err(e) = self.writer.lock().unwrap_or_else(|p| p.into_inner()).append(&cells) {
+                        self.write_failed.store(true, SeqCst);
+                        return Err(e.into());
+                    }
+                    let mut finished = self.finished.lock().unwrap_or_else(|p| p.into_inner());
+                    finished.push((summary.outcome == "error", summary.sim_time_s));
+                    progress.inc(1);
+                    Ok(Some(summary))
+                })
+                .collect()
+        });
+        progress.finish_and_clear();
+        let mut summaries = Vec::with_capacity(runs.len());
+        for o in outcomes {
+            match o? {
+                Some(s) => summaries.push(s),
+                None => anyhow::bail!("stopped before every run of the batch finished"),
+            }
+        }
+        Ok(summaries)
+    }
 }

@@ -4,10 +4,16 @@
 //! - [`results`]: the incremental `results.csv`, its rows and shard merging.
 //! - [`durable`]: checking, repairing and locking a results file before a resume appends.
 //! - [`execute`]: checking and running the runs in parallel.
+//! - [`contour`]: a summary field's threshold, for maps that follow a figure's contour.
+//! - [`adaptive`]: a sweep refined over two of its keys ([`refine`] on each of its maps).
+//! - [`refine`]: adaptive refinement of a two-key grid (only the cells whose runs disagree).
 
+pub mod adaptive;
 pub mod columns;
+pub mod contour;
 pub mod durable;
 pub mod execute;
+pub mod refine;
 pub mod results;
 pub mod spec;
 
