@@ -3,6 +3,10 @@
 //! has one): held, harvested, bruised; the window of setpoints that holds (or harvests) it without
 //! bruising it, or "none" with the reason.
 
+mod bump;
+
+pub use bump::{BumpRow, FORCES_N as BUMP_FORCES_N, bump_test};
+
 use super::{StudyRun, cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
 use tendril_run::scenario::PickPlaceScenario;
@@ -96,6 +100,8 @@ pub struct ProduceRow {
     pub bruise_area_mm2: Option<f64>,
     /// Time above it \[s\].
     pub time_above_s: Option<f64>,
+    /// The bump's mean share of the pad's force while the item was held.
+    pub bump_share: Option<f64>,
     /// Simulated seconds per CPU second.
     pub sim_s_per_cpu_s: f64,
     /// The run's error, if it ended on one.
@@ -104,7 +110,7 @@ pub struct ProduceRow {
 
 impl ProduceRow {
     /// The columns of `produce.csv`.
-    pub const HEADER: [&'static str; 16] = [
+    pub const HEADER: [&'static str; 17] = [
         "scenario",
         "item",
         "task",
@@ -119,6 +125,7 @@ impl ProduceRow {
         "bruise_threshold_kpa",
         "bruise_area_mm2",
         "time_above_s",
+        "bump_share",
         "sim_s_per_cpu_s",
         "error",
     ];
@@ -139,6 +146,7 @@ impl ProduceRow {
             cell(self.bruise_threshold_kpa),
             cell(self.bruise_area_mm2),
             cell(self.time_above_s),
+            cell(self.bump_share),
             format!("{}", self.sim_s_per_cpu_s),
             self.error.replace(['\n', '\r'], " "),
         ]
@@ -368,6 +376,7 @@ fn row(scenario: &Path, task: &'static str, run: &StudyRun) -> ProduceRow {
         bruise_threshold_kpa: p.map(|p| p.bruise_threshold_kpa),
         bruise_area_mm2: p.map(|p| p.bruise_area_mm2),
         time_above_s: p.map(|p| p.time_above_s),
+        bump_share: p.and_then(|p| p.bump_share),
         sim_s_per_cpu_s: s.sim_s_per_cpu_s,
         error: s.error.clone().unwrap_or_default(),
     }
@@ -381,18 +390,35 @@ pub struct Outcome {
     pub windows: Vec<Window>,
 }
 
-/// Runs the plan on `threads` workers; writes `calibration.csv`, `plates.csv`, `produce.csv`,
+/// The plate and bump tests of each item of the plan, once per item: a harvest's item is usually
+/// a pick's too, but a plan of harvests alone still needs its items' tests (it used to test only
+/// the picks' items and fail on an empty `plates.csv`).
+pub fn item_tests(plan: &Plan) -> anyhow::Result<(Vec<PlateRow>, Vec<CalibrationRow>, Vec<BumpRow>)> {
+    let (mut plates, mut calibrations, mut bumps) = (Vec::new(), Vec::new(), Vec::new());
+    let mut tested: Vec<String> = Vec::new();
+    for scenario in plan.picks.iter().chain(&plan.harvests) {
+        let s: PickPlaceScenario = tendril_config::load(scenario, &[])?;
+        if tested.contains(&s.object.label()) {
+            continue;
+        }
+        tested.push(s.object.label());
+        let (rows, cal) = plate_test(scenario)?;
+        plates.extend(rows);
+        calibrations.push(cal);
+        bumps.extend(bump_test(scenario)?);
+    }
+    Ok((plates, calibrations, bumps))
+}
+
+/// Runs the plan on `threads` workers; writes `calibration.csv`, `plates.csv`, `bump.csv`, `produce.csv`,
 /// `produce_window.csv` and the charts in `out`.
 pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
     std::fs::create_dir_all(out).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
     let mut files = Vec::new();
-    // The plate test of each item once (a harvest's item is a pick's too).
-    let (mut plates, mut calibrations) = (Vec::new(), Vec::new());
-    for scenario in &plan.picks {
-        let (rows, cal) = plate_test(scenario)?;
-        plates.extend(rows);
-        calibrations.push(cal);
-    }
+    let (plates, calibrations, bumps) = item_tests(plan)?;
+    let path = out.join("bump.csv");
+    write_csv(&path, &BumpRow::HEADER, &bumps.iter().map(BumpRow::cells).collect::<Vec<_>>())?;
+    files.push(path);
     let path = out.join("calibration.csv");
     write_csv(&path, &CalibrationRow::HEADER, &calibrations.iter().map(CalibrationRow::cells).collect::<Vec<_>>())?;
     files.push(path);
@@ -453,9 +479,22 @@ mod tests {
             bruise_threshold_kpa: Some(150.0),
             bruise_area_mm2: Some(0.0),
             time_above_s: Some(0.0),
+            bump_share: Some(0.5),
             sim_s_per_cpu_s: 5.0,
             error: String::new(),
         }
+    }
+
+    #[test]
+    fn a_plan_of_harvests_alone_tests_its_items_between_plates() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let plan = Plan::new(&[root.join("scenarios/tomato-harvest.toml")], true, &[]).unwrap();
+        assert!(plan.picks.is_empty() && plan.harvests.len() == 1);
+        let (plates, calibrations, bumps) = item_tests(&plan).unwrap();
+        assert!(!plates.is_empty(), "plates.csv gets the harvested item's plate test");
+        assert_eq!(calibrations.len(), 1);
+        assert_eq!(bumps.len(), BUMP_FORCES_N.len());
+        assert!(bumps.iter().all(|b| b.item == calibrations[0].item));
     }
 
     #[test]

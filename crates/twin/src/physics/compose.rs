@@ -1,5 +1,6 @@
 //! Assembles a scene's MJCF from the parts in models/ and the scenario's values.
 
+use super::bump::{self, BumpCalibration, PadShape};
 use super::config::{ArmMode, Backend, FingerConfig, Integrator};
 pub use super::header::header;
 use super::object::ObjectModel;
@@ -184,6 +185,9 @@ pub struct ProducePart {
     pub item: ProduceItem,
     /// The contact stiffness that meets Hertz in the plate test ([`plates::calibrate`]).
     pub calibration: Calibration,
+    /// The pad's bump's own contact with the item, meeting Hertz for the bump's radius
+    /// ([`bump::calibrate`]).
+    pub bump: BumpCalibration,
 }
 
 /// Where the scene's parts stand at the start, in the world frame.
@@ -222,7 +226,7 @@ pub fn placement(spec: &SceneSpec, object: Option<&ObjectModel>) -> Placement {
 
 /// The produce item of `spec` as its scenario configures it, calibrated: refused on the rapier
 /// backend (it has no flex) and with an integrator that does not integrate a flex's elasticity.
-fn produce_part(spec: &SceneSpec, raw: &ProduceItem) -> Result<ProducePart, PhysicsError> {
+fn produce_part(spec: &SceneSpec, raw: &ProduceItem, pad: &PadShape) -> Result<ProducePart, PhysicsError> {
     if spec.physics.backend == Backend::Rapier {
         return Err(PhysicsError::Unsupported {
             backend: "rapier",
@@ -240,7 +244,8 @@ fn produce_part(spec: &SceneSpec, raw: &ProduceItem) -> Result<ProducePart, Phys
     let object = spec.object.as_ref();
     let item = raw.configured(&spec.produce, object.and_then(|o| o.mass_kg), object.and_then(|o| o.friction))?;
     let calibration = plates::calibrate(&item, &spec.physics)?;
-    Ok(ProducePart { item, calibration })
+    let bump = bump::calibrate(&item, &spec.physics, pad, calibration.contact(&spec.physics))?;
+    Ok(ProducePart { item, calibration, bump })
 }
 
 /// The full scene MJCF for `spec`, where its parts start, and its produce item if it has one.
@@ -266,7 +271,8 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement, Option<ProducePart>
         visual.push_str(section(&table, "visual"));
         match (object.as_ref().and_then(|o| o.produce.as_ref()), place.object) {
             (Some(raw), Some(foot)) => {
-                let p = produce_part(spec, raw)?;
+                let pad = PadShape::read(&part(models, "sensor_pad.xml")?)?;
+                let p = produce_part(spec, raw, &pad)?;
                 // The item's centre stands its height above its footprint, in a static frame its
                 // flex's nodes slide in.
                 let centre = [foot.x, foot.y, foot.z + p.item.radii_m[2]];
@@ -282,7 +288,12 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement, Option<ProducePart>
     }
     // The hand rides on the arm's flange in both modes; the kinematic mode prescribes the joints'
     // motion (Scene::step) instead of driving them with servos, so it has no arm actuators.
-    let finger_doc = finger(&spec.finger, &spec.extra_pads, models)?;
+    let mut finger_doc = finger(&spec.finger, &spec.extra_pads, models)?;
+    if let Some(p) = &produce {
+        // The pads' bumps meet the item with their own calibrated contact (bump.rs says why a
+        // higher priority on the geom is how); a rigid object's scene is left as it was.
+        finger_doc = bump::with_bump_contact(&finger_doc, &bump::bump_attrs(&p.item, p.bump.contact(&spec.physics)));
+    }
     let arm = render(&part(models, "ur5e.xml")?, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
     worldbody.push_str(section(&arm, "worldbody"));
     if spec.physics.arm_mode == ArmMode::Dynamic {

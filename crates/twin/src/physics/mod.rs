@@ -14,11 +14,13 @@
 //! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
 //! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
 //! - [`produce`]: a produce item's model file (a flex), [`plates`] its compression between two
-//!   plates and the calibration against [`hertz`], [`damage`] the contact pressure on it.
+//!   plates and the calibration against [`hertz`], [`bump`] the sensor pad's bump's own contact
+//!   with it, [`damage`] the contact pressure on it.
 //! - `spec.rs`: what a scene holds ([`SceneSpec`]); `engine.rs`: the [`Physics`] trait; `readout.rs`:
 //!   what a run hands out ([`PhysicsReadout`], [`Snapshot`]); `start.rs`: a run on a model
 //!   ([`SceneModel::start`]).
 
+pub mod bump;
 pub mod census;
 pub mod check;
 pub mod compose;

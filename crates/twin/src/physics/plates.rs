@@ -71,7 +71,7 @@ impl Calibration {
 
 /// Critical damping of a direct-format contact of `stiffness` \[1/s\] (MuJoCo: a damping ratio
 /// of 1 is `2 √stiffness`).
-fn critical(stiffness: f64) -> f64 {
+pub(crate) fn critical(stiffness: f64) -> f64 {
     2.0 * stiffness.sqrt()
 }
 
@@ -86,45 +86,75 @@ pub fn plate_modulus_pa(item: &ProduceItem) -> f64 {
     hertz::contact_modulus_pa(p.modulus_pa, p.poisson, f64::INFINITY, 0.0)
 }
 
-/// The plates-and-item MJCF with the item's contact stiffness `stiffness`, in `physics`' options.
-fn scene(item: &ProduceItem, physics: &PhysicsConfig, stiffness: f64) -> String {
+/// A rigid body closing on the item along x: its MJCF, surface at the body's origin, facing the
+/// item from the side `sign` (+1: from +x).
+pub(crate) type Presser<'a> = &'a dyn Fn(f64) -> String;
+
+/// The squeeze's MJCF: the item (its document with `contact` on its flex) between two mocap
+/// bodies `plate_plus` and `plate_minus` holding `presser(+1)` and `presser(−1)`, in `physics`'
+/// options.
+pub(crate) fn squeeze_scene(
+    item: &ProduceItem,
+    physics: &PhysicsConfig,
+    contact: ([f64; 2], [f64; 3]),
+    presser: Presser,
+) -> String {
     let x = item.radii_m[0] + START_GAP_M;
-    let half = 2.0 * item.radii_m.iter().cloned().fold(0.0, f64::max);
-    let plate = |name: &str, sign: f64| {
+    let body = |name: &str, sign: f64| {
         format!(
-            r#"<body name="{name}" mocap="true" pos="{px} 0 0">
-      <geom name="{name}" type="box" size="0.001 {h} {h}" pos="{gx} 0 0" contype="2" conaffinity="0"/>
-    </body>"#,
+            r#"<body name="{name}" mocap="true" pos="{px} 0 0">{geoms}</body>"#,
             px = num(sign * x),
-            gx = num(sign * 0.001),
-            h = num(half),
+            geoms = presser(sign)
         )
     };
     format!(
         "<mujoco model=\"plates\">\n  {header}\n  <worldbody>\n    {top}\n    {bottom}\n    {item}\n  </worldbody>\n</mujoco>\n",
         header = header(physics),
-        top = plate("plate_plus", 1.0),
-        bottom = plate("plate_minus", -1.0),
-        item = section(&item.document(([stiffness, critical(stiffness)], physics.contact_solimp)), "worldbody"),
+        top = body("plate_plus", 1.0),
+        bottom = body("plate_minus", -1.0),
+        item = section(&item.document(contact), "worldbody"),
     )
 }
 
-/// Squeezes `item` (contact stiffness `stiffness`, direct format \[1/s²\]) between the plates
-/// until one carries `max_force_n` or they have travelled the item's radius; returns a sample per
-/// step from first contact on.
-pub fn compress(
+/// A flat rigid plate, larger than the item, as [`squeeze_scene`] takes it.
+fn plate(item: &ProduceItem, sign: f64) -> String {
+    let h = 2.0 * item.radii_m.iter().cloned().fold(0.0, f64::max);
+    let name = if sign > 0.0 { "plate_plus" } else { "plate_minus" };
+    format!(
+        r#"<geom name="{name}" type="box" size="0.001 {h} {h}" pos="{gx} 0 0" contype="2" conaffinity="0"/>"#,
+        gx = num(sign * 0.001),
+        h = num(h),
+    )
+}
+
+/// One step of a squeeze: the bodies' travel since first contact and the normal force on the item
+/// of each group of the `plate_plus` body's geoms.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Squeezed {
+    /// Both bodies' travel since the first group first touched the item \[m\].
+    pub travel_m: f64,
+    /// Normal force of each group's geoms on the item \[N\].
+    pub forces_n: Vec<f64>,
+}
+
+/// Closes the bodies of `xml` ([`squeeze_scene`]) on the item at [`PLATE_SPEED_M_S`] each until
+/// the geoms of `groups[0]` push it with `max_force_n` or the bodies have travelled the item's
+/// radius; returns a sample per step from first contact on. Gravity is off: the item floats
+/// between the two.
+pub(crate) fn squeeze(
     item: &ProduceItem,
     physics: &PhysicsConfig,
-    stiffness: f64,
+    xml: &str,
+    groups: &[&[&str]],
     max_force_n: f64,
-) -> Result<Vec<PlateSample>, PhysicsError> {
-    let xml = scene(item, physics, stiffness);
-    let mut model = MjModel::from_xml_string(&xml).map_err(|e| PhysicsError::Object {
+) -> Result<Vec<Squeezed>, PhysicsError> {
+    let mut model = MjModel::from_xml_string(xml).map_err(|e| PhysicsError::Object {
         file: item.source.clone(),
         what: format!("MuJoCo cannot compile the plate test: {e:?}"),
     })?;
     model.opt_mut().gravity = [0.0; 3];
-    let plus = model.name_to_id(_mjtObjBase::mjOBJ_GEOM, "plate_plus").expect("the plate scene names it");
+    let geom = |name: &str| model.name_to_id(_mjtObjBase::mjOBJ_GEOM, name).expect("the squeeze scene names it");
+    let groups: Vec<Vec<usize>> = groups.iter().map(|g| g.iter().map(|n| geom(n)).collect()).collect();
     let flex = model.name_to_id(_mjtObjBase::mjOBJ_FLEX, FLEX_NAME).expect("read checked the flex");
     let mocap = |m: &MjModel, body: &str| {
         let b = m.name_to_id(_mjtObjBase::mjOBJ_BODY, body).expect("the plate scene names it");
@@ -142,32 +172,59 @@ pub fn compress(
         data.mocap_pos_mut()[m_plus][0] = x0 - s;
         data.mocap_pos_mut()[m_minus][0] = -(x0 - s);
         data.step();
-        let mut force = 0.0;
+        let mut forces = vec![0.0; groups.len()];
         for (i, c) in data.contact().iter().enumerate() {
-            let on_plate = (c.geom[0] as usize == plus && c.flex[1] as usize == flex)
-                || (c.geom[1] as usize == plus && c.flex[0] as usize == flex);
-            if on_plate && c.efc_address >= 0 {
-                force += data.contact_force(i)[0];
+            if c.efc_address < 0 {
+                continue;
+            }
+            let other = if c.flex[1] == flex as i32 {
+                c.geom[0]
+            } else if c.flex[0] == flex as i32 {
+                c.geom[1]
+            } else {
+                continue;
+            };
+            for (sum, group) in forces.iter_mut().zip(&groups) {
+                if other >= 0 && group.contains(&(other as usize)) {
+                    *sum += data.contact_force(i)[0];
+                }
             }
         }
-        if !force.is_finite() {
+        let force = forces[0];
+        if !forces.iter().all(|f| f.is_finite()) {
             return Err(PhysicsError::Diverged {
                 time_s: data.time(),
                 cause: super::Divergence::NonFinite { what: "plate force" },
             });
         }
-        // The plates' travel since first contact: each plate has closed `s`, the gap first.
+        // The bodies' travel since first contact: each has closed `s`, the gap first.
         if force > 0.0 && touched_at.is_none() {
             touched_at = Some(s - PLATE_SPEED_M_S * dt);
         }
         if let Some(s0) = touched_at {
-            samples.push(PlateSample { travel_m: 2.0 * (s - s0), force_n: force });
+            samples.push(Squeezed { travel_m: 2.0 * (s - s0), forces_n: forces });
             if force >= max_force_n {
                 break;
             }
         }
     }
     Ok(samples)
+}
+
+/// Squeezes `item` (contact stiffness `stiffness`, direct format \[1/s²\]) between the plates
+/// until one carries `max_force_n` or they have travelled the item's radius; returns a sample per
+/// step from first contact on.
+pub fn compress(
+    item: &ProduceItem,
+    physics: &PhysicsConfig,
+    stiffness: f64,
+    max_force_n: f64,
+) -> Result<Vec<PlateSample>, PhysicsError> {
+    let xml = squeeze_scene(item, physics, ([stiffness, critical(stiffness)], physics.contact_solimp), &|sign| {
+        plate(item, sign)
+    });
+    let samples = squeeze(item, physics, &xml, &[&["plate_plus"]], max_force_n)?;
+    Ok(samples.into_iter().map(|s| PlateSample { travel_m: s.travel_m, force_n: s.forces_n[0] }).collect())
 }
 
 /// The travel at which `samples` first reach `force_n` \[m\] (linear between samples; `None`
@@ -187,6 +244,41 @@ pub fn travel_at(samples: &[PlateSample], force_n: f64) -> Option<f64> {
 /// The contact stiffness at the start of the calibration \[1/s²\]: that of MuJoCo's positive
 /// format at the cell's 5 ms time constant (`1 / (0.99² · 0.005²)`).
 const FIRST_STIFFNESS: f64 = 4.1e4;
+
+/// The contact stiffness \[1/s²\] at which `travel_with` gives the travel `target_m`, and that
+/// travel: a secant search on the travel against the stiffness (in logarithms, where it is nearly
+/// straight) from [`FIRST_STIFFNESS`], to 0.5 %, at most a hundredfold per step and never above
+/// what the step can hold (1e9 /s²). When stiffer contacts no longer shorten the travel, or the
+/// search ends short of the target, `too_soft(travel)` is the error.
+pub(crate) fn search_stiffness(
+    target_m: f64,
+    travel_with: impl Fn(f64) -> Result<f64, PhysicsError>,
+    too_soft: impl Fn(f64) -> PhysicsError,
+) -> Result<(f64, f64), PhysicsError> {
+    let target = target_m;
+    let (mut k0, mut t0) = (FIRST_STIFFNESS, travel_with(FIRST_STIFFNESS)?);
+    let mut k1 = k0 * (t0 / target).powi(2);
+    let mut t1 = travel_with(k1)?;
+    for _ in 0..8 {
+        if ((t1 - target) / target).abs() < 5e-3 {
+            break;
+        }
+        let slope = (t1.ln() - t0.ln()) / (k1.ln() - k0.ln());
+        if slope.is_nan() || slope >= -1e-3 {
+            // Stiffer contacts no longer shorten the travel: the bulk carries it all.
+            return Err(too_soft(t1));
+        }
+        let next = (k1.ln() + (target.ln() - t1.ln()) / slope).exp();
+        let next = next.clamp(k1 / 100.0, (k1 * 100.0).min(1e9));
+        (k0, t0) = (k1, t1);
+        k1 = next;
+        t1 = travel_with(k1)?;
+    }
+    if ((t1 - target) / target).abs() >= 5e-3 {
+        return Err(too_soft(t1));
+    }
+    Ok((k1, t1))
+}
 
 /// The contact stiffness \[1/s²\] whose plate test meets Hertz's force at
 /// [`REFERENCE_FORCE_N`]: a secant search on the travel at that force against the stiffness (in
@@ -217,28 +309,7 @@ pub fn calibrate(item: &ProduceItem, physics: &PhysicsConfig) -> Result<Calibrat
             target * 1e3
         ),
     };
-    let (mut k0, mut t0) = (FIRST_STIFFNESS, travel_with(FIRST_STIFFNESS)?);
-    let mut k1 = k0 * (t0 / target).powi(2);
-    let mut t1 = travel_with(k1)?;
-    for _ in 0..8 {
-        if ((t1 - target) / target).abs() < 5e-3 {
-            break;
-        }
-        let slope = (t1.ln() - t0.ln()) / (k1.ln() - k0.ln());
-        if slope.is_nan() || slope >= -1e-3 {
-            // Stiffer contacts no longer shorten the travel: the bulk carries it all.
-            return Err(too_soft(t1));
-        }
-        let next = (k1.ln() + (target.ln() - t1.ln()) / slope).exp();
-        // At most a hundredfold per step, and never above what the step can hold (1e9 /s²).
-        let next = next.clamp(k1 / 100.0, (k1 * 100.0).min(1e9));
-        (k0, t0) = (k1, t1);
-        k1 = next;
-        t1 = travel_with(k1)?;
-    }
-    if ((t1 - target) / target).abs() >= 5e-3 {
-        return Err(too_soft(t1));
-    }
+    let (k1, t1) = search_stiffness(target, travel_with, too_soft)?;
     Ok(Calibration {
         contact_stiffness: k1,
         contact_damping: critical(k1),

@@ -100,7 +100,7 @@ fn child_span(text: &str, child: &str) -> Option<(usize, usize)> {
 }
 
 /// The value of attribute `name` in the tag text `tag` (`<x a="1" b="2"`).
-fn attr(tag: &str, name: &str) -> Option<String> {
+pub(crate) fn attr(tag: &str, name: &str) -> Option<String> {
     let key = format!(" {name}=\"");
     let at = tag.find(&key)? + key.len();
     let len = tag[at..].find('"')?;
@@ -108,7 +108,7 @@ fn attr(tag: &str, name: &str) -> Option<String> {
 }
 
 /// `tag` with attribute `name` set to `value` (replaced, or added before the tag's end).
-fn with_attr(tag: &str, name: &str, value: &str) -> String {
+pub(crate) fn with_attr(tag: &str, name: &str, value: &str) -> String {
     let key = format!(" {name}=\"");
     match tag.find(&key) {
         Some(at) => {
@@ -378,6 +378,12 @@ impl ProduceItem {
         let s = x * x / a.powi(4) + y * y / b.powi(4) + z * z / c.powi(4);
         let gauss = 1.0 / (a * a * b * b * c * c * s * s);
         [gauss.sqrt(); 2]
+    }
+
+    /// The flex's `<contact>` attribute `name` as the file (and the overrides) give it (`None`
+    /// when unset: MuJoCo's default).
+    pub fn contact_attr(&self, name: &str) -> Option<String> {
+        child_span(&self.mjcf, "contact").and_then(|(a, b)| attr(&self.mjcf[a..b], name))
     }
 
     /// The radius the finger wraps (the larger horizontal semi-axis) \[m\].
