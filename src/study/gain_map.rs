@@ -17,7 +17,7 @@ pub const KI: [f64; 5] = [0.0, 0.05, 0.5, 5.0, 50.0];
 /// How the map is refined.
 #[derive(Debug, Clone)]
 pub struct Refinement {
-    /// The coarse grid's stride [points]; 1 runs every point.
+    /// The coarse grid's stride \[points\]; 1 runs every point.
     pub stride: usize,
     /// A figure's contour to follow besides held / dropped / oscillating.
     pub contour: Option<Contour>,

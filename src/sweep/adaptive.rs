@@ -16,7 +16,7 @@ use tendril_run::summary::RunSummary;
 pub struct RefineOptions {
     /// The two grid keys the maps span.
     pub keys: [String; 2],
-    /// The coarse grid's stride [points]; 1 runs every point.
+    /// The coarse grid's stride \[points\]; 1 runs every point.
     pub stride: usize,
     /// A figure's contour to follow besides the outcome and oscillation.
     pub contour: Option<Contour>,

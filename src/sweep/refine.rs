@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 /// A point of the grid by its indices along the two axes.
 pub type Point = (usize, usize);
 
-/// The coarse grid's stride [points] when the user gives none: every fourth point of each axis
+/// The coarse grid's stride \[points\] when the user gives none: every fourth point of each axis
 /// (and its last). A choice: on the 18 × 18 gain map the smallest region (the oscillating corner
 /// at Ki ≥ 5 with a weak Kp) is 5 points or more along each axis, wider than 4; a stride of 8
 /// could pass over a region of 7.
