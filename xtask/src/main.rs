@@ -185,10 +185,20 @@ fn run_tests(extra: &[String]) -> Result<(), String> {
     let python = python_clients()?;
     // The Python extension (a cdylib built by maturin, below) has no Rust tests of its own.
     let workspace = ["test", "--workspace", "--exclude", "tendril-python"];
-    run(cargo().args(workspace).arg("--all-targets").args(extra).env("TENDRIL_PYTHON", &python))?;
+    timed("the Rust tests (build and run)", || {
+        run(cargo().args(workspace).arg("--all-targets").args(extra).env("TENDRIL_PYTHON", &python))
+    })?;
     // The crates' READMEs are their docs, and their samples are doctests (`--all-targets` runs none).
-    run(cargo().args(workspace).arg("--doc").args(extra).env("TENDRIL_PYTHON", &python))?;
-    python_package_tests(&python)
+    timed("the doctests", || run(cargo().args(workspace).arg("--doc").args(extra).env("TENDRIL_PYTHON", &python)))?;
+    timed("the Python package's tests (build and pytest)", || python_package_tests(&python))
+}
+
+/// Runs `step`, then says how long it took, so a CI log shows where its time goes.
+fn timed(what: &str, step: impl FnOnce() -> Result<(), String>) -> Result<(), String> {
+    let started = std::time::Instant::now();
+    let result = step();
+    eprintln!("xtask: {what}: {:.0} s", started.elapsed().as_secs_f64());
+    result
 }
 
 /// What the Python package's tests need beside the package's own dependencies (numpy and
