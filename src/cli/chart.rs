@@ -203,7 +203,6 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
     // The refinements start from the first scenario's own timestep and links (after --set).
     let scenarios = objects_or(&a.scenario);
     let base: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&scenarios[0], &extra)?;
-    let (dt, links) = (base.physics.timestep_s, base.finger.segments);
     let finest = a.finest_step.unwrap_or(FINEST_TIMESTEP_S);
     // 1e-5 s: the scenario's own lower bound on `physics.timestep_s`.
     if !(1e-5..=FINEST_TIMESTEP_S).contains(&finest) {
@@ -214,19 +213,8 @@ fn convergence(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<(Vec<Path
     if a.quick && a.finest_step.is_some() {
         anyhow::bail!("--finest-step: the --quick plan has no finest setting (default, step/2 and links x2 only)");
     }
-    // A produce item's study refines its flex as well (the same plan with or without --quick).
-    let produce = base.object.model()?.produce;
-    let plan = match produce {
-        Some(item) => {
-            let flex = study::convergence::FlexSetting {
-                count: base.produce.count.unwrap_or(item.count[0]),
-                dof: base.produce.dof.unwrap_or(item.dof),
-            };
-            study::convergence::Plan::produce(dt, links, flex)
-        }
-        None if a.quick => Plan::quick(dt, links),
-        None => Plan::full(dt, links, finest),
-    };
+    // A produce item's study refines its flex as well (with --quick, the step only).
+    let plan = Plan::for_scenario(&base, a.quick, finest)?;
     let seeds = if a.seeds.is_empty() { vec![1, 2, 3] } else { a.seeds.clone() };
     let cases: Vec<Case> = scenarios
         .into_iter()

@@ -158,6 +158,38 @@ impl Plan {
         let comparisons = (1..settings.len()).map(|i| (0, i)).collect();
         Plan { settings, comparisons }
     }
+
+    /// A produce item's CI-sized study: the default against step/2 only (the first refinement
+    /// of [`Plan::produce`]).
+    pub fn produce_quick(timestep_s: f64, segments: u32, flex: FlexSetting) -> Plan {
+        let mut plan = Plan::produce(timestep_s, segments, flex);
+        plan.settings.truncate(2);
+        plan.comparisons.truncate(1);
+        plan
+    }
+
+    /// The plan for `scenario` as loaded (its `--set`s applied), from its own timestep, links and,
+    /// for a produce item, its flex's grid and degrees of freedom (the scenario's `[produce]` or
+    /// the item's file): [`Plan::produce`] (with `quick`, [`Plan::produce_quick`]) for a produce
+    /// item, else [`Plan::full`] down to `finest_timestep_s` (with `quick`, [`Plan::quick`]).
+    pub fn for_scenario(
+        scenario: &tendril_run::scenario::PickPlaceScenario,
+        quick: bool,
+        finest_timestep_s: f64,
+    ) -> anyhow::Result<Plan> {
+        let (dt, links) = (scenario.physics.timestep_s, scenario.finger.segments);
+        Ok(match scenario.object.model()?.produce {
+            Some(item) => {
+                let flex = FlexSetting {
+                    count: scenario.produce.count.unwrap_or(item.count[0]),
+                    dof: scenario.produce.dof.unwrap_or(item.dof),
+                };
+                if quick { Plan::produce_quick(dt, links, flex) } else { Plan::produce(dt, links, flex) }
+            }
+            None if quick => Plan::quick(dt, links),
+            None => Plan::full(dt, links, finest_timestep_s),
+        })
+    }
 }
 
 /// One case: a scenario (object), a feedback mode and a seed.
@@ -513,6 +545,37 @@ mod tests {
         let finest = finer.settings.last().unwrap();
         assert_eq!((finest.timestep_s, finest.segments), (0.00015625, 32));
         assert_eq!(finer.comparisons.len(), plan.comparisons.len());
+    }
+
+    #[test]
+    fn a_produce_plan_refines_the_flex_and_its_quick_form_the_step_only() {
+        use tendril_twin::physics::Dof;
+        let flex = FlexSetting { count: 7, dof: Dof::Trilinear };
+        let plan = Plan::produce(0.0025, 8, flex);
+        let settings: Vec<(&str, f64, u32, u32, Dof)> = plan
+            .settings
+            .iter()
+            .map(|s| {
+                let f = s.flex.unwrap();
+                (s.label.as_str(), s.timestep_s, s.segments, f.count, f.dof)
+            })
+            .collect();
+        assert_eq!(
+            settings,
+            [
+                ("default", 0.0025, 8, 7, Dof::Trilinear),
+                ("step/2", 0.00125, 8, 7, Dof::Trilinear),
+                ("links x2", 0.0025, 16, 7, Dof::Trilinear),
+                ("grid x2", 0.0025, 8, 13, Dof::Trilinear),
+                ("quadratic", 0.0025, 8, 7, Dof::Quadratic)
+            ]
+        );
+        assert_eq!(plan.comparisons, [(0, 1), (0, 2), (0, 3), (0, 4)]);
+        // Already quadratic: nothing finer to try in the degrees of freedom.
+        assert_eq!(Plan::produce(0.0025, 8, FlexSetting { dof: Dof::Quadratic, ..flex }).settings.len(), 4);
+        let quick = Plan::produce_quick(0.0025, 8, flex);
+        assert_eq!(quick.settings, plan.settings[..2]);
+        assert_eq!(quick.comparisons, [(0, 1)]);
     }
 
     #[test]
