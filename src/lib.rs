@@ -15,10 +15,12 @@
 //! - [`keys`]: the scenario key reference (`tendril keys`), generated from the code.
 //! - [`reproduce`]: the paper's figures next to the twin's (`tendril reproduce`).
 //! - [`signals`]: SIGINT, SIGTERM and SIGHUP as one clean stop.
+//! - [`features`]: the optional parts (`viewer`, `video`) and how to build one that is missing.
 
 #![warn(missing_docs)]
 
 pub mod cli;
+pub mod features;
 pub mod fit;
 pub mod keys;
 pub mod render;

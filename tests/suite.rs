@@ -35,6 +35,8 @@ mod physics_validation;
 mod plot;
 mod produce;
 mod protocol_props;
+mod readme_tour;
+#[cfg(feature = "video")]
 mod render;
 mod results_durability;
 mod ros2_msgs_package;
@@ -48,4 +50,5 @@ mod sensor_hysteresis_compensation;
 mod sensor_reproduce;
 mod sensor_roundtrip;
 mod slip_detection;
+#[cfg(feature = "viewer")]
 mod view;

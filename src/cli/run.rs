@@ -54,6 +54,10 @@ impl RunArgs {
 pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let scenario: PickPlaceScenario = a.scenario.load(a.overrides())?;
     let dir = a.out.clone().unwrap_or_else(|| tendril_run::output::default_run_dir(&scenario.name));
+    if a.video {
+        // Said before the run, not after it.
+        crate::features::Feature::Video.require("tendril run --video")?;
+    }
     if a.video && a.hardware != "sim" {
         anyhow::bail!(
             "--video renders the twin's recorded frames; a {} cell records none (leave out --video)",

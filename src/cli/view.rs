@@ -35,6 +35,7 @@ fn speed_arg(s: &str) -> Result<f64, String> {
 
 /// `tendril view`: the scenario on the twin in MuJoCo's interactive viewer.
 pub fn run(a: ViewArgs) -> anyhow::Result<ExitCode> {
+    crate::features::Feature::Viewer.require("tendril view")?;
     let scenario: PickPlaceScenario = a.scenario.load([])?;
     // Ctrl-C, SIGTERM and SIGHUP: the run's safe stop, then the window closes.
     crate::signals::install_signal_handlers()?;

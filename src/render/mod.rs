@@ -9,9 +9,10 @@
 //!
 //! - [`frames`]: the `frames.bin` format and the recorder the simulated cell feeds.
 //! - [`overlay`]: the force-trace panel.
-//! - [`video`]: H.264 (OpenH264) in MP4.
+//! - [`video`]: H.264 (OpenH264) in MP4, the `video` feature ([`crate::features`]).
 
 pub mod overlay;
+#[cfg(feature = "video")]
 pub mod video;
 
 use std::path::{Path, PathBuf};
@@ -143,6 +144,7 @@ pub fn frame_count(cell_s: f64, fps: f64, speed: f64) -> usize {
 /// `trace.csv`) to `opts.out`.
 pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> anyhow::Result<RenderStats> {
     let started = std::time::Instant::now();
+    crate::features::Feature::Video.require("tendril render")?;
     opts.check()?;
     let log = FrameLog::read(&run_dir.join(FRAMES_FILE))?;
     if log.is_empty() {
@@ -251,6 +253,28 @@ fn frame_state(log: &FrameLog, i: usize) -> Snapshot {
     let (qvel, rest) = rest.split_at(s.nv);
     let (ctrl, act) = rest.split_at(s.nu);
     Snapshot { qpos: qpos.to_vec(), qvel: qvel.to_vec(), ctrl: ctrl.to_vec(), act: act.to_vec() }
+}
+
+/// A build without the `video` feature has no encoder to make: [`render_run`] has already said
+/// how to build one (the type has no value, so nothing is ever encoded without it).
+#[cfg(not(feature = "video"))]
+mod video {
+    /// The encoder a build without OpenH264 cannot make.
+    pub struct Mp4Encoder(std::convert::Infallible);
+
+    impl Mp4Encoder {
+        pub fn new(_width: u32, _height: u32, _fps: f64) -> anyhow::Result<Mp4Encoder> {
+            Err(crate::features::Feature::Video.missing("tendril render"))
+        }
+
+        pub fn add_frame(&mut self, _rgb: &[u8]) -> anyhow::Result<()> {
+            match self.0 {}
+        }
+
+        pub fn finish(self, _path: &std::path::Path) -> anyhow::Result<u64> {
+            match self.0 {}
+        }
+    }
 }
 
 #[cfg(test)]

@@ -12,16 +12,25 @@
 //! - [`pace`]: cell time against wall time at a speed factor.
 //! - [`live`]: the viewer, the wrapped cell and the panel.
 
+//!
+//! The viewer is the `viewer` feature ([`crate::features`]); a build without it keeps the view's
+//! options and errors, and [`view`] says how to build it.
+
 pub mod display;
+#[cfg(feature = "viewer")]
 pub mod keys;
+#[cfg(feature = "viewer")]
 pub mod live;
 pub mod pace;
 
+#[cfg(feature = "viewer")]
 pub use live::LiveCell;
 use std::path::PathBuf;
 use tendril_run::runner::Outcome;
 use tendril_run::scenario::PickPlaceScenario;
+#[cfg(feature = "viewer")]
 use tendril_run::session::{Action, Session};
+#[cfg(feature = "viewer")]
 use tendril_twin::physics::{Backend, SceneModel};
 
 /// Why the viewer could not show the run.
@@ -86,6 +95,7 @@ pub struct ViewReport {
 /// Runs `scenario` on the twin in the live viewer until the window closes (or `opts.seconds`
 /// pass): the task once, then its final state on screen. Fails before any window when there is
 /// no display, the scenario's backend has no MuJoCo state or the screenshot's folder is missing.
+#[cfg(feature = "viewer")]
 pub fn view(scenario: &PickPlaceScenario, opts: &ViewOptions) -> anyhow::Result<ViewReport> {
     let spec = scenario.scene_spec();
     if spec.physics.backend != Backend::Mujoco {
@@ -129,4 +139,10 @@ pub fn view(scenario: &PickPlaceScenario, opts: &ViewOptions) -> anyhow::Result<
         frames: live.frames(),
         wall_s: live.wall_s(),
     })
+}
+
+/// A build without the `viewer` feature: the error that says how to build it.
+#[cfg(not(feature = "viewer"))]
+pub fn view(_scenario: &PickPlaceScenario, _opts: &ViewOptions) -> anyhow::Result<ViewReport> {
+    Err(crate::features::Feature::Viewer.missing("tendril view"))
 }

@@ -6,9 +6,10 @@
 //! - `cargo xtask fetch`: unpack MuJoCo 3.17.0 from the PyPI wheel into `vendor/mujoco/lib`.
 //! - `cargo xtask main`: fetch, install `tendril` (`cargo install --path . --locked`, reusing the
 //!   workspace's release build), then run the main job (`tendril reproduce ...`).
-//! - `cargo xtask test`: fetch, install the Python protocol clients into `vendor/venv`, then run
-//!   the whole test suite with `TENDRIL_PYTHON` pointing at that venv; then build the Python
-//!   package into that venv and run its tests (`python/tests`, pytest).
+//! - `cargo xtask test`: fetch, install the Python protocol clients into `vendor/venv`, build the
+//!   workspace's tests (every feature) and, beside them, the Python package into that venv; then
+//!   run the whole test suite with `TENDRIL_PYTHON` pointing at that venv, and the Python
+//!   package's tests (`python/tests`, pytest).
 //! - `cargo xtask layers`: check the workspace's rules (the crates' layers, the light crates'
 //!   dependencies, no module loops; [`layers`]).
 //! - `cargo xtask book`: build the book in `docs/` into `target/book` with mdBook, installed
@@ -181,16 +182,32 @@ fn install_bin_dir() -> PathBuf {
 }
 
 /// The whole test suite (what `.ci/run` runs): the workspace's tests, then the Python package's.
+///
+/// The Python extension builds beside the Rust tests' build, in a target folder of its own (two
+/// cargo processes on one folder take turns): that build spends most of its time linking test
+/// binaries one after another and leaves the second core idle, which the extension's build fills
+/// (docs/guide/install.md, "Where CI's time goes"). Nothing runs until both are built, so the
+/// real-time tests meet an idle machine.
 fn run_tests(extra: &[String]) -> Result<(), String> {
     let python = python_clients()?;
-    // The Python extension (a cdylib built by maturin, below) has no Rust tests of its own.
-    let workspace = ["test", "--workspace", "--exclude", "tendril-python"];
-    timed("the Rust tests (build and run)", || {
-        run(cargo().args(workspace).arg("--all-targets").args(extra).env("TENDRIL_PYTHON", &python))
-    })?;
+    python_test_tools(&python)?;
+    // The Python extension (a cdylib built by maturin, below) has no Rust tests of its own. Every
+    // feature: the optional parts `cargo xtask main` leaves out (the viewer, the video) are tested too.
+    let workspace = ["test", "--workspace", "--exclude", "tendril-python", "--all-features"];
+    let rust_tests = || {
+        let mut c = cargo();
+        c.args(workspace).arg("--all-targets").args(extra).env("TENDRIL_PYTHON", &python);
+        c
+    };
+    let extension = PythonBuild::start(&python)?;
+    let built = timed("the Rust tests: build", || run(rust_tests().arg("--no-run")));
+    let extension_built = timed("the Python extension: the rest of its build", || extension.finish());
+    built?;
+    extension_built?;
+    timed("the Rust tests: run", || run(&mut rust_tests()))?;
     // The crates' READMEs are their docs, and their samples are doctests (`--all-targets` runs none).
     timed("the doctests", || run(cargo().args(workspace).arg("--doc").args(extra).env("TENDRIL_PYTHON", &python)))?;
-    timed("the Python package's tests (build and pytest)", || python_package_tests(&python))
+    timed("the Python package's tests (pytest)", || python_package_tests(&python))
 }
 
 /// Runs `step`, then says how long it took, so a CI log shows where its time goes.
@@ -206,14 +223,9 @@ fn timed(what: &str, step: impl FnOnce() -> Result<(), String>) -> Result<(), St
 /// `Run.to_pandas`, and maturin, the build backend. Pinned, like the clients.
 const PYTHON_TEST_TOOLS: [&str; 4] = ["pytest==9.2.0", "gymnasium==1.4.0", "pandas==3.1.1", "maturin==1.16.0"];
 
-/// The Python package (pyproject.toml, python/tendril): built and installed into `vendor/venv`
-/// with `pip install .` (the in-tree backend, without build isolation: the venv has maturin and
-/// mujoco), in the `python-test` profile (the tests' optimisation, see Cargo.toml), then
-/// `pytest python/tests`. pytest's exit code 5 (no test collected) fails the task like any other
-/// non-zero exit.
-fn python_package_tests(python: &Path) -> Result<(), String> {
-    let root = workspace_root();
-    let venv = root.join("vendor/venv");
+/// Installs [`PYTHON_TEST_TOOLS`] into `vendor/venv` once.
+fn python_test_tools(python: &Path) -> Result<(), String> {
+    let venv = workspace_root().join("vendor/venv");
     let stamp = venv.join(format!("tendril-python-tests-{}", PYTHON_TEST_TOOLS.join("-")));
     if !stamp.is_file() {
         eprintln!("xtask: installing {} into {}", PYTHON_TEST_TOOLS.join(", "), venv.display());
@@ -222,16 +234,68 @@ fn python_package_tests(python: &Path) -> Result<(), String> {
             .args(PYTHON_TEST_TOOLS))?;
         std::fs::write(&stamp, "").map_err(|e| format!("{}: {e}", stamp.display()))?;
     }
-    run(Command::new(python)
-        .args(["-m", "pip", "install", "--quiet", "--no-build-isolation", "--no-deps", "--force-reinstall", "."])
-        .env("MATURIN_PEP517_ARGS", "--profile python-test")
-        .current_dir(&root))?;
-    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
+    Ok(())
+}
+
+/// The workspace's target folder (`CARGO_TARGET_DIR` when set).
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| workspace_root().join("target"), PathBuf::from)
+}
+
+/// The Python package (pyproject.toml, python/tendril) building and installing into
+/// `vendor/venv` in the background: `pip install .` (the in-tree backend, without build
+/// isolation: the venv has maturin and mujoco), in the `python-test` profile (the tests'
+/// optimisation, see Cargo.toml), in `TARGET/python` (its own folder, so it builds beside the Rust
+/// tests), its output in `TARGET/python/build.log`.
+struct PythonBuild {
+    child: std::process::Child,
+    log: PathBuf,
+    command: String,
+}
+
+impl PythonBuild {
+    fn start(python: &Path) -> Result<PythonBuild, String> {
+        let dir = target_dir().join("python");
+        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let log = dir.join("build.log");
+        let file = std::fs::File::create(&log).map_err(|e| format!("{}: {e}", log.display()))?;
+        let err = file.try_clone().map_err(|e| format!("{}: {e}", log.display()))?;
+        let mut c = Command::new(python);
+        c.args(["-m", "pip", "install", "--no-build-isolation", "--no-deps", "--force-reinstall", "."])
+            .env("MATURIN_PEP517_ARGS", "--profile python-test")
+            .env("CARGO_TARGET_DIR", &dir)
+            .current_dir(workspace_root())
+            .stdout(file)
+            .stderr(err);
+        let command = format!("{c:?}");
+        let child = c.spawn().map_err(|e| format!("cannot start {command}: {e}"))?;
+        eprintln!("xtask: building the Python extension beside the Rust tests (its output: {})", log.display());
+        Ok(PythonBuild { child, log, command })
+    }
+
+    /// Waits for the build; on failure, the end of its output and where the rest is.
+    fn finish(mut self) -> Result<(), String> {
+        let status = self.child.wait().map_err(|e| format!("{}: {e}", self.command))?;
+        if status.success() {
+            return Ok(());
+        }
+        let text = std::fs::read_to_string(&self.log).unwrap_or_default();
+        let tail: Vec<&str> = text.lines().rev().take(40).collect();
+        for line in tail.iter().rev() {
+            eprintln!("{line}");
+        }
+        Err(format!("{} failed ({status}); its whole output: {}", self.command, self.log.display()))
+    }
+}
+
+/// `pytest python/tests` against the package [`PythonBuild`] installed. pytest's exit code 5 (no
+/// test collected) fails the task like any other non-zero exit.
+fn python_package_tests(python: &Path) -> Result<(), String> {
     run(Command::new(python)
         .args(["-m", "pytest", "-q", "python/tests"])
         // The command line the tests compare runs with: the one `cargo test` just built.
-        .env("TENDRIL_BIN", target.join("debug/tendril"))
-        .current_dir(&root))
+        .env("TENDRIL_BIN", target_dir().join("debug/tendril"))
+        .current_dir(workspace_root()))
 }
 
 /// Independent protocol clients the tests run against the virtual devices (tests/python_clients.rs),
@@ -267,10 +331,8 @@ fn python_clients() -> Result<PathBuf, String> {
 
 /// `cargo xtask urcl`: builds `tendril` (release) and runs UR's client library's examples against it.
 fn urcl_check(rest: &[String]) -> Result<(), String> {
-    let root = workspace_root();
     run(cargo().args(["build", "--release", "--quiet", "--bin", "tendril"]))?;
-    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
-    urcl::run(&root, &target.join("release/tendril"), rest)
+    urcl::run(&workspace_root(), &target_dir().join("release/tendril"), rest)
 }
 
 /// `cargo xtask layers`: every broken rule printed; fails if there is one.
