@@ -5,11 +5,11 @@
 //! `tendril run` built it, sets each recorded state, calls `mj_forward` (so the contacts and their
 //! forces are MuJoCo's for that state) and draws it offscreen through EGL. Under the picture goes
 //! the run's force trace from `trace.csv` with a moving time cursor and the task phase
-//! ([`overlay`]); the frames are encoded as H.264 in an MP4 file ([`video`]) a browser plays.
+//! ([`overlay`]); the frames are encoded as H.264 in an MP4 file (`video`) a browser plays.
 //!
 //! - [`frames`]: the `frames.bin` format and the recorder the simulated cell feeds.
 //! - [`overlay`]: the force-trace panel.
-//! - [`video`]: H.264 (OpenH264) in MP4, the `video` feature ([`crate::features`]).
+//! - `video`: H.264 (OpenH264) in MP4, with the `video` feature ([`crate::features`]).
 
 pub mod overlay;
 #[cfg(feature = "video")]

@@ -1,16 +1,16 @@
 //! The twin live in MuJoCo's interactive viewer (`tendril view`).
 //!
 //! The run is the one `tendril run` makes (a [`tendril_run::session::Session`] on a [`tendril_twin::sim::SimCell`])
-//! with the simulated cell wrapped in a [`LiveCell`]: after the physics reaches each control tick,
+//! with the simulated cell wrapped in a `LiveCell`: after the physics reaches each control tick,
 //! the live cell syncs the viewer with the sim's own `MjData` (the viewer's mouse perturbation
 //! comes back into it as forces on the next steps), draws a frame when one is due and waits until
 //! the tick is due on the wall clock at the chosen speed ([`pace`]). Between ticks the view hands
 //! each tick's row to the on-screen panel and applies the feedback key to the session.
 //!
 //! - [`display`]: whether there is a display to open a window on.
-//! - [`keys`]: the keys and what they ask of the run.
+//! - `keys` (with the `viewer` feature): the keys and what they ask of the run.
 //! - [`pace`]: cell time against wall time at a speed factor.
-//! - [`live`]: the viewer, the wrapped cell and the panel.
+//! - `live` (with the `viewer` feature): the viewer, the wrapped cell and the panel.
 
 //!
 //! The viewer is the `viewer` feature ([`crate::features`]); a build without it keeps the view's
