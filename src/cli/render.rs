@@ -48,7 +48,6 @@ pub struct RenderArgs {
 
 /// `tendril render`: a run's recorded frames as an MP4 video.
 pub fn run(a: RenderArgs) -> anyhow::Result<ExitCode> {
-    crate::features::Feature::Video.require("tendril render")?;
     let opts = RenderOptions {
         out: a.out.clone().unwrap_or_else(|| a.run_dir.join("video.mp4")),
         fps: a.fps,

@@ -11,7 +11,6 @@
 //! - `keys` (with the `viewer` feature): the keys and what they ask of the run.
 //! - [`pace`]: cell time against wall time at a speed factor.
 //! - `live` (with the `viewer` feature): the viewer, the wrapped cell and the panel.
-
 //!
 //! The viewer is the `viewer` feature ([`crate::features`]); a build without it keeps the view's
 //! options and errors, and [`view`] says how to build it.
