@@ -198,7 +198,7 @@ const SHORT_TASK: [&str; 10] = [
 ];
 
 #[test]
-fn the_default_camera_keeps_the_object_in_view_in_every_phase_and_the_fixed_one_loses_it() {
+fn the_default_and_the_follow_camera_keep_the_object_in_view_in_every_phase_and_the_fixed_one_loses_it() {
     let dir = tempfile::tempdir().unwrap();
     let run_dir = dir.path().join("run");
     let run =
@@ -210,13 +210,16 @@ fn the_default_camera_keeps_the_object_in_view_in_every_phase_and_the_fixed_one_
         assert!(names.contains(&phase), "the run has no {phase} phase: {names:?}");
     }
 
-    // The default camera (tracking): the handle is in the picture in every frame of every phase.
-    let tracking = render_with(&run_dir, "tracking", &dir.path().join("tracking.mp4"));
-    for (phase, start, end) in &spans {
-        let frames = (start * FPS).ceil() as usize..=((end * FPS).floor() as usize).min(tracking.len() - 1);
-        for k in frames {
-            let n = red_pixels(&tracking[k]);
-            assert!(n >= 40, "{phase}, t = {:.1} s: {n} pixels of the object in view", k as f64 / FPS);
+    // The default camera (tracking), and the scene's own `follow` camera (the one MuJoCo's
+    // viewers reach with `]`): the handle is in the picture in every frame of every phase.
+    for camera in ["tracking", "follow"] {
+        let pictures = render_with(&run_dir, camera, &dir.path().join(format!("{camera}.mp4")));
+        for (phase, start, end) in &spans {
+            let frames = (start * FPS).ceil() as usize..=((end * FPS).floor() as usize).min(pictures.len() - 1);
+            for k in frames {
+                let n = red_pixels(&pictures[k]);
+                assert!(n >= 40, "{camera}, {phase}, t = {:.1} s: {n} pixels of the object in view", k as f64 / FPS);
+            }
         }
     }
 
@@ -230,7 +233,7 @@ fn the_default_camera_keeps_the_object_in_view_in_every_phase_and_the_fixed_one_
     let out = tendril(&["render", run_dir.to_str().unwrap(), "--camera", "ceiling"]);
     assert!(!out.status.success());
     let err = stderr(&out);
-    assert!(err.contains("--camera ceiling") && err.contains("tracking, fixed, hand"), "{err}");
+    assert!(err.contains("--camera ceiling") && err.contains("tracking, fixed, follow, hand"), "{err}");
 }
 
 #[test]

@@ -3,6 +3,7 @@
 use crate::render::{RenderOptions, render_run};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tendril_twin::physics::follow_camera::DEFAULT_VIEWPOINT;
 
 /// Arguments of `tendril render`.
 #[derive(Debug, clap::Args)]
@@ -26,17 +27,17 @@ pub struct RenderArgs {
     speed: f64,
     /// The camera: `tracking` follows the object through every phase, `fixed` stays aimed at its
     /// start, `hand` looks along the tool from the hand, or the name of a camera in the scene's
-    /// model.
+    /// model (`follow`: the model's camera riding with a rigid object, as MuJoCo's viewers show it).
     #[arg(long, default_value = "tracking")]
     camera: String,
     /// Tracking and fixed camera: distance from the object [m].
-    #[arg(long, default_value_t = 0.35)]
+    #[arg(long, default_value_t = DEFAULT_VIEWPOINT.distance_m)]
     distance: f64,
     /// Tracking and fixed camera: azimuth [°].
-    #[arg(long, default_value_t = 135.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = DEFAULT_VIEWPOINT.azimuth_deg, allow_negative_numbers = true)]
     azimuth: f64,
     /// Tracking and fixed camera: elevation [°] (negative looks down).
-    #[arg(long, default_value_t = -20.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = DEFAULT_VIEWPOINT.elevation_deg, allow_negative_numbers = true)]
     elevation: f64,
     /// Leave out the force panel under the picture.
     #[arg(long)]

@@ -20,6 +20,7 @@ use tendril_render::{Camera, SceneRenderer, View};
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_twin::frames::{self, FRAMES_FILE, FrameLog, Snapshot};
 use tendril_twin::physics::SceneModel;
+use tendril_twin::physics::follow_camera::DEFAULT_VIEWPOINT;
 
 pub use tendril_render::MAX_SIDE;
 
@@ -61,9 +62,9 @@ impl Default for RenderOptions {
             height: 480,
             speed: 1.0,
             camera: Camera::Tracking,
-            distance_m: 0.35,
-            azimuth_deg: 135.0,
-            elevation_deg: -20.0,
+            distance_m: DEFAULT_VIEWPOINT.distance_m,
+            azimuth_deg: DEFAULT_VIEWPOINT.azimuth_deg,
+            elevation_deg: DEFAULT_VIEWPOINT.elevation_deg,
             panel: true,
             still_s: None,
         }

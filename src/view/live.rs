@@ -328,8 +328,8 @@ pub const CAMERA_DISTANCE_M: f64 = 0.6;
 /// The model the viewer draws: the sim's, with its free camera on the object's grip at the start
 /// (from 135° azimuth, 20° above, as `tendril render`) and dressed as `tendril render` dresses it
 /// ([`tendril_render::dress_for_screen`]). Only what the viewer draws differs; the sim keeps its
-/// own model. mujoco-rs's viewer gives no handle on its camera after it opens, so the camera cannot
-/// follow the task by itself: its side panel's camera menu can track a body.
+/// own model. mujoco-rs's viewer gives no handle on its camera after it opens, so the view cannot
+/// move it: the scene's `follow` camera (`]`, or the side panel's camera menu) rides with the object.
 fn viewer_model(sim: &SimCell) -> mujoco_rs::prelude::MjModel {
     let shared = sim.model();
     let start = tendril_twin::physics::Scene::new(shared.clone());
@@ -383,7 +383,11 @@ fn panel(ui: &mut egui::Ui, status: &mut Status) {
             }
         });
         let help: Vec<String> = keys::HELP.iter().map(|(k, what)| format!("{k}: {what}")).collect();
-        ui.small(format!("{}; double-click a body, then Ctrl + Alt + drag: pull it", help.join(", ")));
+        ui.small(format!(
+            "{}; double-click a body, then Ctrl + Alt + drag: pull it; ]: the camera that follows the object, \
+             Esc: the free camera",
+            help.join(", ")
+        ));
     });
 }
 

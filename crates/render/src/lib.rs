@@ -11,6 +11,7 @@ use mujoco_rs::wrappers::mj_visualization::{MjvCamera, MjvOption};
 use std::sync::Arc;
 use tendril_twin::frames::Snapshot;
 use tendril_twin::physics::SceneModel;
+use tendril_twin::physics::follow_camera::DEFAULT_VIEWPOINT;
 
 /// Largest picture side \[px\] (and so the offscreen buffer's).
 pub const MAX_SIDE: u32 = 4096;
@@ -35,16 +36,16 @@ pub struct View {
 }
 
 impl Default for View {
-    /// 640 × 480, the tracking camera 0.35 m from the object, from 135° and 20° above: the grip
-    /// and the finger around it fill the picture.
+    /// 640 × 480, the tracking camera at the scene's [`DEFAULT_VIEWPOINT`] (0.35 m from the
+    /// object, from 135° and 20° above): the grip and the finger around it fill the picture.
     fn default() -> Self {
         View {
             width: 640,
             height: 480,
             camera: Camera::Tracking,
-            distance_m: 0.35,
-            azimuth_deg: 135.0,
-            elevation_deg: -20.0,
+            distance_m: DEFAULT_VIEWPOINT.distance_m,
+            azimuth_deg: DEFAULT_VIEWPOINT.azimuth_deg,
+            elevation_deg: DEFAULT_VIEWPOINT.elevation_deg,
             contact_forces: true,
         }
     }

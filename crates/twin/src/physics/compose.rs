@@ -2,6 +2,7 @@
 
 use super::bump::{self, BumpCalibration, PadShape};
 use super::config::{ArmMode, Backend, FingerConfig, Integrator};
+use super::follow_camera;
 pub use super::header::header;
 use super::object::ObjectModel;
 use super::plates::{self, Calibration};
@@ -294,7 +295,19 @@ pub fn scene(spec: &SceneSpec) -> Result<(String, Placement, Option<ProducePart>
         // higher priority on the geom is how); a rigid object's scene is left as it was.
         finger_doc = bump::with_bump_contact(&finger_doc, &bump::bump_attrs(&p.item, p.bump.contact(&spec.physics)));
     }
-    let arm = render(&part(models, "ur5e.xml")?, &[("hand", section(&finger_doc, "worldbody").to_string())])?;
+    // The `follow` camera (follow_camera.rs): aimed at a rigid object's body, or through the hand
+    // at a produce item (its flex has no body of its own); none without an object.
+    let camera = match (object.as_ref(), place.object) {
+        (Some(o), Some(foot)) => {
+            let target = if produce.is_some() { "hand" } else { "object" };
+            follow_camera::element([foot.x, foot.y, foot.z + o.wrap_height_m], spec.arm_q0[0], target)
+        }
+        _ => String::new(),
+    };
+    let arm = render(
+        &part(models, "ur5e.xml")?,
+        &[("hand", section(&finger_doc, "worldbody").to_string()), ("camera", camera)],
+    )?;
     worldbody.push_str(section(&arm, "worldbody"));
     if spec.physics.arm_mode == ArmMode::Dynamic {
         actuator.push_str(section(&arm, "actuator"));
