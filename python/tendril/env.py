@@ -60,7 +60,8 @@ Render
     ``(render_height, render_width, 3)`` uint8 array. ``render_camera`` chooses the camera as
     ``tendril render --camera`` does: ``"tracking"`` (the default) follows the object through every
     phase, ``"fixed"`` stays aimed at its start, ``"hand"`` looks along the tool from the hand, or
-    the name of a camera in the scene's model. It needs an EGL driver (Mesa's
+    the name of a camera in the scene's model (``"follow"``: the model's camera on the arm's base
+    link, aimed at the object, the one MuJoCo's viewers show). It needs an EGL driver (Mesa's
     ``libegl1 libgl1-mesa-dri`` on Debian/Ubuntu).
 
 Vector

@@ -124,9 +124,11 @@ def test_the_render_camera_follows_the_object_or_stays_and_a_wrong_one_is_named(
     assert abs(mean_row(tracking[1]) - mean_row(tracking[0])) < abs(mean_row(fixed[1]) - mean_row(fixed[0]))
     hand = frames("hand")[1]
     assert red(hand).sum() > 100  # the hand's camera looks at the handle
+    follow = frames("follow")[1]
+    assert red(follow).sum() > 100  # the model's follow camera, aimed at the object, sees it in the lift
     env = GripEnv(SHORT_LIFT, render_mode="rgb_array", render_width=160, render_height=120, render_camera="ceiling")
     env.reset(seed=1)
-    with pytest.raises(RuntimeError, match="camera ceiling.*tracking, fixed, hand"):
+    with pytest.raises(RuntimeError, match="camera ceiling.*tracking, fixed, follow, hand"):
         env.render()
     env.close()
 

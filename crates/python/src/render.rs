@@ -24,7 +24,8 @@ pub struct Renderer {
 impl Renderer {
     /// A renderer for `session`'s scene: `width` × `height` pixels, seen by `camera`: `"tracking"`
     /// (following the object through every phase), `"fixed"` (aimed at its start), `"hand"` (along
-    /// the tool from the hand) or a camera of the model by name; the tracking and fixed cameras
+    /// the tool from the hand) or a camera of the model by name (`"follow"`: the model's camera
+    /// aimed at the object from the arm's base link); the tracking and fixed cameras
     /// stand `distance_m` from the object at `azimuth_deg` and `elevation_deg`. Raises
     /// `RuntimeError` when the machine has no EGL driver (saying what to install) or the camera
     /// does not exist (naming the choices).
