@@ -31,19 +31,11 @@ pub struct Viewpoint {
 pub const DEFAULT_VIEWPOINT: Viewpoint = Viewpoint { distance_m: 0.35, azimuth_deg: 135.0, elevation_deg: -20.0 };
 
 impl Viewpoint {
-    /// The camera's position and its MJCF `xyaxes` (its right and up directions) when it looks at
-    /// `target` \[m\].
-    pub fn pose(&self, target: [f64; 3]) -> ([f64; 3], [f64; 6]) {
+    /// Where a camera stands to look at `target` \[m\] from this viewpoint.
+    pub fn position(&self, target: [f64; 3]) -> [f64; 3] {
         let (az, el) = (self.azimuth_deg.to_radians(), self.elevation_deg.to_radians());
         let forward = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
-        let right = [az.sin(), -az.cos(), 0.0];
-        let up = [
-            right[1] * forward[2] - right[2] * forward[1],
-            right[2] * forward[0] - right[0] * forward[2],
-            right[0] * forward[1] - right[1] * forward[0],
-        ];
-        let pos = std::array::from_fn(|k| target[k] - self.distance_m * forward[k]);
-        (pos, [right[0], right[1], right[2], up[0], up[1], up[2]])
+        std::array::from_fn(|k| target[k] - self.distance_m * forward[k])
     }
 }
 
@@ -52,7 +44,7 @@ impl Viewpoint {
 /// `link1`'s origin is the world's (the arm's base stands at the origin, as the kinematics in
 /// `tendril-ur5e` take it), its frame the world's turned by the base joint about z.
 pub fn element(look_at: [f64; 3], pan_rad: f64, target: &str) -> String {
-    let (world, _) = DEFAULT_VIEWPOINT.pose(look_at);
+    let world = DEFAULT_VIEWPOINT.position(look_at);
     let (s, c) = (-pan_rad).sin_cos();
     let local = [c * world[0] - s * world[1], s * world[0] + c * world[1], world[2]];
     format!(
@@ -66,27 +58,21 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_pose_looks_at_the_target_from_the_viewpoint() {
+    fn the_position_looks_at_the_target_from_the_viewpoint() {
         let target = [0.1, -0.2, 0.3];
-        let (pos, axes) = DEFAULT_VIEWPOINT.pose(target);
+        let pos = DEFAULT_VIEWPOINT.position(target);
         let d: Vec<f64> = (0..3).map(|k| target[k] - pos[k]).collect();
         let dist = d.iter().map(|x| x * x).sum::<f64>().sqrt();
         assert!((dist - 0.35).abs() < 1e-12, "{dist}");
         // Looking down 20°, along azimuth 135°.
         assert!(((d[2] / dist).asin().to_degrees() + 20.0).abs() < 1e-9);
         assert!((d[1].atan2(d[0]).to_degrees() - 135.0).abs() < 1e-9);
-        // Right and up: unit, orthogonal, both orthogonal to the view, up above the horizon.
-        let (x, y) = (&axes[..3], &axes[3..]);
-        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
-        assert!((dot(x, x) - 1.0).abs() < 1e-12 && (dot(y, y) - 1.0).abs() < 1e-12);
-        assert!(dot(x, y).abs() < 1e-12 && dot(x, &d).abs() < 1e-12 && dot(y, &d).abs() < 1e-12);
-        assert!(y[2] > 0.0);
     }
 
     #[test]
     fn the_element_puts_the_camera_at_the_viewpoint_in_the_turned_link() {
         let look_at = [0.4, 0.3, 0.2];
-        let (world, _) = DEFAULT_VIEWPOINT.pose(look_at);
+        let world = DEFAULT_VIEWPOINT.position(look_at);
         let pan = 0.7_f64;
         let text = element(look_at, pan, "object");
         let pos: Vec<f64> = text
