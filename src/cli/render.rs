@@ -27,7 +27,8 @@ pub struct RenderArgs {
     speed: f64,
     /// The camera: `tracking` follows the object through every phase, `fixed` stays aimed at its
     /// start, `hand` looks along the tool from the hand, or the name of a camera in the scene's
-    /// model (`follow`: the model's camera riding with a rigid object, as MuJoCo's viewers show it).
+    /// model (`follow`: the model's camera on the arm's base link, aimed at the object, as
+    /// MuJoCo's viewers show it).
     #[arg(long, default_value = "tracking")]
     camera: String,
     /// Tracking and fixed camera: distance from the object [m].

@@ -329,7 +329,7 @@ pub const CAMERA_DISTANCE_M: f64 = 0.6;
 /// (from 135° azimuth, 20° above, as `tendril render`) and dressed as `tendril render` dresses it
 /// ([`tendril_render::dress_for_screen`]). Only what the viewer draws differs; the sim keeps its
 /// own model. mujoco-rs's viewer gives no handle on its camera after it opens, so the view cannot
-/// move it: the scene's `follow` camera (`]`, or the side panel's camera menu) rides with the object.
+/// move it: the scene's `follow` camera (`]`, or the side panel's camera menu) follows the object.
 fn viewer_model(sim: &SimCell) -> mujoco_rs::prelude::MjModel {
     let shared = sim.model();
     let start = tendril_twin::physics::Scene::new(shared.clone());

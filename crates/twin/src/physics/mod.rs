@@ -12,7 +12,7 @@
 //! - [`guide`]: the guide's walls left out of the collision search while they cannot touch the
 //!   strip; [`census`]: contacts per geom pair over a run (what the collision search finds).
 //! - [`export`]: the scene as one standalone MJCF with a start keyframe (`tendril scene`).
-//! - [`follow_camera`]: the `follow` camera that rides with the object (for viewers and pictures).
+//! - [`follow_camera`]: the `follow` camera that turns with the arm's base and aims at the object (for viewers and pictures).
 //! - [`object`]: an object's model file, its contract checked, its mass and grip read from it.
 //! - [`produce`]: a produce item's model file (a flex), [`plates`] its compression between two
 //!   plates and the calibration against [`hertz`], [`bump`] the sensor pad's bump's own contact
