@@ -103,6 +103,25 @@ fn the_detected_class_chooses_the_setpoint_and_gains_from_the_table() {
 }
 
 #[test]
+fn the_produce_table_holds_a_row_for_every_object_of_the_cycle_s_produce_studies() {
+    let table = "detector.table=object-table-produce.toml";
+    for (scenario, setpoint_n, kp) in [
+        ("scenarios/cherry-tomato.toml", 0.6, 20.0),
+        ("scenarios/strawberry.toml", 0.4, 20.0),
+        ("scenarios/crimper.toml", 0.6, 79.451),
+        ("scenarios/shampoo.toml", 0.8, 60.5248),
+        ("scenarios/hammer.toml", 1.6, 80.0),
+    ] {
+        let s = load(scenario, &[table]).unwrap();
+        assert_eq!(s.detection().unwrap().settings, s.object.label(), "{scenario}");
+        assert_eq!((s.setpoint_n, s.controller.pid().unwrap().kp), (setpoint_n, kp), "{scenario}");
+    }
+    // A fruit taken for a hammer gets the hammer's squeeze, which the study finds bruises it.
+    let s = load("scenarios/strawberry.toml", &[table, "detector.confusion.strawberry={ hammer = 1.0 }"]).unwrap();
+    assert_eq!(s.setpoint_n, 1.6);
+}
+
+#[test]
 fn bad_cycle_settings_are_refused_by_key() {
     let (key, reason) = refused_at("scenarios/crimper.toml", &["task.settled_grasp.dwell_s=20"]);
     assert_eq!(key, "task.settled_grasp.dwell_s");
@@ -190,4 +209,33 @@ fn the_finger_studys_quick_form_sizes_the_finger_and_recommends_one() {
     ]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("task.growth_m"), "{}", stderr(&bad));
+}
+
+#[test]
+fn the_finger_study_on_a_produce_item_counts_the_flex_s_contact_area_and_its_damage() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tendril(&[
+        "chart",
+        "finger",
+        "--quick",
+        "--growth",
+        "0.14",
+        "--scenario",
+        "scenarios/cherry-tomato.toml",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let runs = read(&dir.path().join("finger.csv"));
+    assert_eq!(runs.len(), 2, "feedback on and off");
+    for r in &runs {
+        // The item's side of a contact is its flex, not a geom: the wrap's area still counts.
+        let pressure: f64 = r["peak_pressure_kpa"].parse().unwrap();
+        assert!(pressure > 10.0, "the grip presses on the fruit: {r:?}");
+        assert_eq!(r["bruised"], (pressure > 150.0).to_string(), "{r:?}");
+    }
+    let summary = read(&dir.path().join("finger_summary.csv"));
+    let area: f64 = summary[0]["contact_area_mean_cm2"].parse().unwrap();
+    assert!(area > 1.0, "the wrap lies on the fruit: {area} cm²");
+    assert!(summary[0]["peak_pressure_mean_kpa"].parse::<f64>().unwrap() > 10.0, "{:?}", summary[0]);
 }

@@ -4,14 +4,15 @@
 //! - **pairs**: every object run with every class's settings from the table (the detector always
 //!   reports that class; a confusion row of one) and with none (a miss: the table's fallback, or
 //!   the scenario's own settings): held runs, fluctuation while moving, peak force and cycle time
-//!   per (true, assumed) pair: what a wrong class costs.
+//!   per (true, assumed) pair, and for a produce item the runs that bruised it and its peak
+//!   contact pressure: what a wrong class costs.
 //! - **accuracy**: every object with a detector of each accuracy (the rest spread evenly over the
 //!   other classes) and a fixed miss rate: held runs and fluctuation against accuracy.
 //!
 //! The objects are scenario files and the classes the table's rows: a further object (a produce
 //! item) is one more scenario and one more `[classes.NAME]` row, no code changed.
 
-use super::{cell, run_all, set, write_csv};
+use super::{Damage, cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
 use tendril_config::Override;
 use tendril_plot::panels::{Mark, Panel, Panels, Series};
@@ -29,6 +30,8 @@ pub struct Plan {
     pub table: PathBuf,
     /// The accuracies of the second part.
     pub accuracies: Vec<f64>,
+    /// Whether the second part also runs a detector at chance (one over the table's classes).
+    pub chance: bool,
     /// Its miss rate.
     pub miss_rate: f64,
     /// The seeds of every case.
@@ -37,14 +40,15 @@ pub struct Plan {
 
 impl Plan {
     /// The plan: quick (accuracies 1 and 0.5, seeds 1-2) or full (1, 0.95, 0.9, 0.8, 0.6 and
-    /// chance among three classes, seeds 1-10), `seeds` replacing the default when given; a miss
-    /// rate of 5 %.
+    /// chance among the table's classes, seeds 1-10), `seeds` replacing the default when given; a
+    /// miss rate of 5 %.
     pub fn new(scenarios: Vec<PathBuf>, table: PathBuf, quick: bool, seeds: &[u64]) -> Plan {
         let default_seeds: Vec<u64> = if quick { vec![1, 2] } else { (1..=10).collect() };
         Plan {
             scenarios,
             table,
-            accuracies: if quick { vec![1.0, 0.5] } else { vec![1.0, 0.95, 0.9, 0.8, 0.6, 1.0 / 3.0] },
+            accuracies: if quick { vec![1.0, 0.5] } else { vec![1.0, 0.95, 0.9, 0.8, 0.6] },
+            chance: !quick,
             miss_rate: 0.05,
             seeds: if seeds.is_empty() { default_seeds } else { seeds.to_vec() },
         }
@@ -68,6 +72,10 @@ pub struct PairRow {
     pub peak_force_mean_n: Option<f64>,
     /// Mean cycle time \[s\].
     pub cycle_mean_s: Option<f64>,
+    /// Runs that bruised their produce item (0 for a rigid object).
+    pub bruised: usize,
+    /// Mean of the runs' peak contact pressure on a produce item \[kPa\].
+    pub peak_pressure_mean_kpa: Option<f64>,
 }
 
 /// One (object, accuracy) over its seeds.
@@ -85,6 +93,10 @@ pub struct AccuracyRow {
     pub held: usize,
     /// Mean of the held runs' largest fluctuation while moving [%].
     pub fluctuation_mean_pct: Option<f64>,
+    /// Runs that bruised their produce item (0 for a rigid object).
+    pub bruised: usize,
+    /// Whether the object is a produce item (its runs report damage).
+    pub produce: bool,
 }
 
 /// What the study wrote and found.
@@ -107,6 +119,7 @@ struct Run {
     fluctuation_pct: Option<f64>,
     peak_force_n: Option<f64>,
     cycle_s: f64,
+    damage: Damage,
     error: Option<String>,
 }
 
@@ -149,6 +162,7 @@ fn run_cases(
                 fluctuation_pct: s.metrics.max_fluctuation_pct,
                 peak_force_n: s.metrics.peak_force_n,
                 cycle_s: s.sim_time_s,
+                damage: Damage::of(&s),
                 error: s.error,
             }
         })
@@ -182,14 +196,15 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
             .collect();
         pairs.push(("miss".into(), base(1.0, 1.0)));
         pair_runs.extend(run_cases(scenario, &pairs, &plan.seeds, threads)?);
+        let chance = plan.chance.then(|| 1.0 / classes.len() as f64);
         let levels: Vec<(String, Vec<Override>)> =
-            plan.accuracies.iter().map(|&a| (format!("{a}"), base(a, plan.miss_rate))).collect();
+            plan.accuracies.iter().chain(chance.iter()).map(|&a| (format!("{a}"), base(a, plan.miss_rate))).collect();
         accuracy_runs.extend(run_cases(scenario, &levels, &plan.seeds, threads)?);
     }
     std::fs::create_dir_all(out).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
     let runs_csv = out.join("detector_runs.csv");
     let run_cells = |part: &str, r: &Run| {
-        vec![
+        let mut cells = vec![
             part.to_string(),
             r.object.clone(),
             r.case.clone(),
@@ -199,8 +214,10 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
             cell(r.fluctuation_pct),
             cell(r.peak_force_n),
             format!("{}", r.cycle_s),
-            r.error.clone().unwrap_or_default(),
-        ]
+        ];
+        cells.extend(r.damage.cells());
+        cells.push(r.error.clone().unwrap_or_default());
+        cells
     };
     let rows: Vec<Vec<String>> = pair_runs
         .iter()
@@ -219,6 +236,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
             "fluctuation_pct",
             "peak_force_n",
             "cycle_s",
+            "peak_pressure_kpa",
+            "bruised",
             "error",
         ],
         &rows,
@@ -227,7 +246,17 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
     let pairs_csv = out.join("detector_pairs.csv");
     write_csv(
         &pairs_csv,
-        &["object", "assumed", "runs", "held", "fluctuation_mean_pct", "peak_force_mean_n", "cycle_mean_s"],
+        &[
+            "object",
+            "assumed",
+            "runs",
+            "held",
+            "fluctuation_mean_pct",
+            "peak_force_mean_n",
+            "cycle_mean_s",
+            "bruised",
+            "peak_pressure_mean_kpa",
+        ],
         &pairs
             .iter()
             .map(|p| {
@@ -239,6 +268,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                     cell(p.fluctuation_mean_pct),
                     cell(p.peak_force_mean_n),
                     cell(p.cycle_mean_s),
+                    p.bruised.to_string(),
+                    cell(p.peak_pressure_mean_kpa),
                 ]
             })
             .collect::<Vec<_>>(),
@@ -247,7 +278,7 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
     let accuracy_csv = out.join("detector_accuracy.csv");
     write_csv(
         &accuracy_csv,
-        &["object", "accuracy", "runs", "correct", "held", "fluctuation_mean_pct"],
+        &["object", "accuracy", "runs", "correct", "held", "fluctuation_mean_pct", "bruised"],
         &accuracy
             .iter()
             .map(|a| {
@@ -258,6 +289,7 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                     a.correct.to_string(),
                     a.held.to_string(),
                     cell(a.fluctuation_mean_pct),
+                    a.bruised.to_string(),
                 ]
             })
             .collect::<Vec<_>>(),
@@ -278,6 +310,8 @@ fn pair_summary(runs: &[Run]) -> Vec<PairRow> {
                 fluctuation_mean_pct: mean(g.iter().filter(|r| r.outcome == "held").filter_map(|r| r.fluctuation_pct)),
                 peak_force_mean_n: mean(g.iter().filter_map(|r| r.peak_force_n)),
                 cycle_mean_s: mean(g.iter().filter(|r| r.outcome != "error").map(|r| r.cycle_s)),
+                bruised: g.iter().filter(|r| r.damage.is_bruised()).count(),
+                peak_pressure_mean_kpa: mean(g.iter().filter_map(|r| r.damage.peak_pressure_kpa)),
                 object,
                 assumed,
             }
@@ -296,16 +330,20 @@ fn accuracy_summary(runs: &[Run]) -> Vec<AccuracyRow> {
                 correct: g.iter().filter(|r| r.reported.as_deref() == Some(object.as_str())).count(),
                 held: g.iter().filter(|r| r.outcome == "held").count(),
                 fluctuation_mean_pct: mean(g.iter().filter(|r| r.outcome == "held").filter_map(|r| r.fluctuation_pct)),
+                bruised: g.iter().filter(|r| r.damage.is_bruised()).count(),
+                produce: g.iter().any(|r| r.damage.bruised.is_some()),
                 object,
             }
         })
         .collect()
 }
 
-/// Held runs and fluctuation against the detector's accuracy, a series per object.
+/// Held runs and fluctuation against the detector's accuracy, a series per object; with produce,
+/// the runs that bruised each item too.
 fn chart(rows: &[AccuracyRow]) -> Panels {
     let objects = tendril_plot::grid::first_seen(rows.iter().map(|r| r.object.clone()));
-    let series = |value: &dyn Fn(&AccuracyRow) -> Option<f64>| {
+    let produce = tendril_plot::grid::first_seen(rows.iter().filter(|r| r.produce).map(|r| r.object.clone()));
+    let series_of = |objects: &[String], value: &dyn Fn(&AccuracyRow) -> Option<f64>| {
         objects
             .iter()
             .map(|o| Series {
@@ -319,30 +357,41 @@ fn chart(rows: &[AccuracyRow]) -> Panels {
             })
             .collect::<Vec<_>>()
     };
+    let series = |value: &dyn Fn(&AccuracyRow) -> Option<f64>| series_of(&objects, value);
+    let mut panels = vec![
+        Panel {
+            caption: "held runs".into(),
+            x_desc: "detector accuracy [%]".into(),
+            y_desc: "held [% of seeds]".into(),
+            series: series(&|r| Some(100.0 * r.held as f64 / r.runs.max(1) as f64)),
+            y_range: Some((0.0, 105.0)),
+        },
+        Panel {
+            caption: "largest fluctuation while moving, held runs".into(),
+            x_desc: "detector accuracy [%]".into(),
+            y_desc: "mean over seeds [%]".into(),
+            series: series(&|r| r.fluctuation_mean_pct),
+            y_range: None,
+        },
+    ];
+    if !produce.is_empty() {
+        panels.push(Panel {
+            caption: "produce: runs that bruised the item".into(),
+            x_desc: "detector accuracy [%]".into(),
+            y_desc: "bruised [% of seeds]".into(),
+            series: series_of(&produce, &|r| Some(100.0 * r.bruised as f64 / r.runs.max(1) as f64)),
+            y_range: Some((0.0, 105.0)),
+        });
+    }
     Panels {
         title: "Settings chosen by a detected class: held runs and fluctuation against the detector's accuracy".into(),
-        panels: vec![
-            Panel {
-                caption: "held runs".into(),
-                x_desc: "detector accuracy [%]".into(),
-                y_desc: "held [% of seeds]".into(),
-                series: series(&|r| Some(100.0 * r.held as f64 / r.runs.max(1) as f64)),
-                y_range: Some((0.0, 105.0)),
-            },
-            Panel {
-                caption: "largest fluctuation while moving, held runs".into(),
-                x_desc: "detector accuracy [%]".into(),
-                y_desc: "mean over seeds [%]".into(),
-                series: series(&|r| r.fluctuation_mean_pct),
-                y_range: None,
-            },
-        ],
-        columns: 2,
+        columns: panels.len(),
+        panels,
     }
 }
 
 /// The pairs as a markdown table: rows the true object, columns the assumed class, each cell held
-/// runs, mean fluctuation and peak force.
+/// runs, mean fluctuation and peak force, and for produce the runs that bruised it.
 pub fn pairs_markdown(pairs: &[PairRow]) -> String {
     let objects = tendril_plot::grid::first_seen(pairs.iter().map(|p| p.object.clone()));
     let assumed = tendril_plot::grid::first_seen(pairs.iter().map(|p| p.assumed.clone()));
@@ -353,11 +402,13 @@ pub fn pairs_markdown(pairs: &[PairRow]) -> String {
             .iter()
             .map(|a| match pairs.iter().find(|p| &p.object == o && &p.assumed == a) {
                 Some(p) => format!(
-                    "{}/{} held, {} %, peak {} N",
+                    "{}/{} held, {} %, peak {} N{}",
                     p.held,
                     p.runs,
                     p.fluctuation_mean_pct.map_or("-".into(), |f| format!("{f:.0}")),
-                    p.peak_force_mean_n.map_or("-".into(), |f| format!("{f:.2}"))
+                    p.peak_force_mean_n.map_or("-".into(), |f| format!("{f:.2}")),
+                    p.peak_pressure_mean_kpa
+                        .map_or(String::new(), |kpa| format!(", {}/{} bruised, {kpa:.0} kPa", p.bruised, p.runs))
                 ),
                 None => "-".into(),
             })

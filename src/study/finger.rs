@@ -9,7 +9,7 @@
 //! - feedback on (the paper's mode 2): held or not, the largest pad force (estimate) and grip
 //!   force (ground truth, the strip and pad on the object) while holding, the area of the finger's
 //!   faces on the object when the lift starts ([`tendril_twin::physics::Scene::contact_area_m2`]),
-//!   and the cycle time;
+//!   the cycle time and, for a produce item, whether the grip bruised it and its peak pressure;
 //! - feedback off (the paper's mode 1, the grip frozen when the arm starts): how long the grip
 //!   holds the object after the arm starts, the hold margin: the creep-limited reserve of the
 //!   grip, which the paper's Fig. 9 measures (10 / 13 / 17 s for crimper / shampoo / hammer on the
@@ -18,7 +18,7 @@
 //! The objects are scenario files: a further object (a produce item) is studied by passing its
 //! scenario with `--scenario`, no code changed.
 
-use super::{cell, set, write_csv};
+use super::{Damage, cell, set, write_csv};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use tendril_config::Override;
@@ -102,6 +102,7 @@ struct Figures {
     peak_grip_n: Option<f64>,
     contact_area_m2: Option<f64>,
     cycle_s: f64,
+    damage: Damage,
     error: Option<String>,
 }
 
@@ -139,6 +140,7 @@ fn run_one(scenario: &PickPlaceScenario, models: &ModelCache) -> anyhow::Result<
             .reduce(f64::max),
         contact_area_m2: area,
         cycle_s: summary.sim_time_s,
+        damage: Damage::of(&summary),
         error: summary.error,
     })
 }
@@ -169,6 +171,10 @@ pub struct FingerRow {
     pub peak_grip_mean_n: Option<f64>,
     /// Mean cycle time \[s\] (feedback on).
     pub cycle_mean_s: Option<f64>,
+    /// Runs with feedback on that bruised their produce item (0 for a rigid object).
+    pub bruised: usize,
+    /// Mean of the peak contact pressure on a produce item \[kPa\] (feedback on).
+    pub peak_pressure_mean_kpa: Option<f64>,
 }
 
 /// What the study wrote and found.
@@ -229,6 +235,7 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                     peak_grip_n: None,
                     contact_area_m2: None,
                     cycle_s: f64::NAN,
+                    damage: Damage::default(),
                     error: Some(format!("{e:#}")),
                 });
                 progress.inc(1);
@@ -254,13 +261,15 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
             "peak_force_n",
             "peak_grip_n",
             "cycle_s",
+            "peak_pressure_kpa",
+            "bruised",
             "error",
         ],
         &cases
             .iter()
             .zip(&figures)
             .map(|(c, f)| {
-                vec![
+                let mut cells = vec![
                     c.object.clone(),
                     format!("{}", c.growth_m),
                     format!("{}", c.pad_height_m),
@@ -273,8 +282,10 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                     cell(f.peak_force_n),
                     cell(f.peak_grip_n),
                     format!("{}", f.cycle_s),
-                    f.error.clone().unwrap_or_default(),
-                ]
+                ];
+                cells.extend(f.damage.cells());
+                cells.push(f.error.clone().unwrap_or_default());
+                cells
             })
             .collect::<Vec<_>>(),
     )?;
@@ -302,6 +313,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                 peak_force_mean_n: mean(on.iter().filter_map(|f| f.peak_force_n)),
                 peak_grip_mean_n: mean(on.iter().filter_map(|f| f.peak_grip_n)),
                 cycle_mean_s: mean(on.iter().filter(|f| f.outcome != "error").map(|f| f.cycle_s)),
+                bruised: on.iter().filter(|f| f.damage.is_bruised()).count(),
+                peak_pressure_mean_kpa: mean(on.iter().filter_map(|f| f.damage.peak_pressure_kpa)),
                 object,
             }
         })
@@ -321,6 +334,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
             "peak_force_mean_n",
             "peak_grip_mean_n",
             "cycle_mean_s",
+            "bruised",
+            "peak_pressure_mean_kpa",
         ],
         &summary
             .iter()
@@ -337,6 +352,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
                     cell(r.peak_force_mean_n),
                     cell(r.peak_grip_mean_n),
                     cell(r.cycle_mean_s),
+                    r.bruised.to_string(),
+                    cell(r.peak_pressure_mean_kpa),
                 ]
             })
             .collect::<Vec<_>>(),
@@ -387,7 +404,7 @@ fn chart(summary: &[FingerRow]) -> Panels {
 }
 
 /// The size the numbers recommend: among those that held every run with feedback on for every
-/// object, the gentlest whose frozen grip (feedback off) still carried every object to the end of
+/// object without bruising a produce item, the gentlest whose frozen grip (feedback off) still carried every object to the end of
 /// the carry: the smallest largest grip force over the objects, ties by the shorter cycle. The
 /// hold margin is capped by the carry, so once a grip carries to its end a tighter one only
 /// squeezes harder (a pad recessed into the sleeve leaves the wrap's force to the strip, which the
@@ -416,12 +433,14 @@ pub fn recommend(summary: &[FingerRow]) -> String {
         let held: usize = rs.iter().map(|r| r.held).sum();
         let runs: usize = rs.iter().map(|r| r.runs).sum();
         let frozen: usize = rs.iter().map(|r| r.held_frozen).sum();
+        let bruised: usize = rs.iter().map(|r| r.bruised).sum();
+        let bruised = if bruised > 0 { format!(", {bruised} bruised") } else { String::new() };
         let per_object: Vec<String> = rs
             .iter()
             .map(|r| format!("{} {}", r.object, r.margin_mean_s.map_or("-".into(), |m| format!("{m:.1} s"))))
             .collect();
         format!(
-            "growth {:.2} cm, pad {:.1} mm proud: held {held} of {runs} with feedback on, {frozen} of {runs} carried \
+            "growth {:.2} cm, pad {:.1} mm proud: held {held} of {runs} with feedback on{bruised}, {frozen} of {runs} carried \
              frozen; hold margin at least {margin:.1} s ({}), grip force at most {:.1} N, finger area on the object \
              at least {area:.1} cm², mean cycle {cycle:.1} s",
             f64::from_bits(s.0) * 100.0,
@@ -430,8 +449,11 @@ pub fn recommend(summary: &[FingerRow]) -> String {
             max_grip(s),
         )
     };
-    let held: Vec<(u64, u64)> =
-        sizes.iter().copied().filter(|&s| rows(s).iter().all(|r| r.held == r.runs && r.runs > 0)).collect();
+    let held: Vec<(u64, u64)> = sizes
+        .iter()
+        .copied()
+        .filter(|&s| rows(s).iter().all(|r| r.held == r.runs && r.runs > 0 && r.bruised == 0))
+        .collect();
     let carried = held.iter().copied().filter(|&s| rows(s).iter().all(|r| r.held_frozen == r.runs));
     let gentlest = carried.min_by(|&a, &b| max_grip(a).total_cmp(&max_grip(b)).then(cycle(a).total_cmp(&cycle(b))));
     let best = gentlest.or_else(|| {
@@ -440,11 +462,46 @@ pub fn recommend(summary: &[FingerRow]) -> String {
             sa.0.total_cmp(&sb.0).then(sa.1.total_cmp(&sb.1)).then(sb.2.total_cmp(&sa.2))
         })
     });
-    let Some(best) = best else { return "recommended: none of the sizes held every run of every object".into() };
+    let Some(best) = best else {
+        return "recommended: none of the sizes held every run of every object without bruising it".into();
+    };
     let mut text = format!("recommended: {}", describe(best));
     let paper = (0.14_f64.to_bits(), 0.0055_f64.to_bits());
     if best != paper && sizes.contains(&paper) {
         text += &format!("; the paper's finger: {}", describe(paper));
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(growth_m: f64, peak_grip_mean_n: f64, bruised: usize) -> FingerRow {
+        FingerRow {
+            object: "cherry_tomato".into(),
+            growth_m,
+            pad_height_m: 0.0055,
+            runs: 2,
+            held: 2,
+            margin_mean_s: Some(21.0),
+            held_frozen: 2,
+            contact_area_mean_cm2: Some(3.0),
+            peak_force_mean_n: Some(0.6),
+            peak_grip_mean_n: Some(peak_grip_mean_n),
+            cycle_mean_s: Some(43.0),
+            bruised,
+            peak_pressure_mean_kpa: Some(100.0),
+        }
+    }
+
+    #[test]
+    fn a_size_that_bruises_a_produce_item_is_not_recommended() {
+        // The gentler grip bruised the fruit once (its bump pressed on it): the other size wins.
+        let summary = vec![row(0.14, 3.0, 1), row(0.175, 5.0, 0)];
+        let text = recommend(&summary);
+        assert!(text.starts_with("recommended: growth 17.50 cm"), "{text}");
+        let text = recommend(&[row(0.14, 3.0, 1)]);
+        assert!(text.contains("without bruising"), "{text}");
+    }
 }

@@ -97,6 +97,37 @@ pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<String>]) -> anyhow::
     w.flush().map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
+/// A produce item's damage in one run of a study (both fields absent for a rigid object), so the
+/// cycle's studies can count a grip that held but bruised as the failure it is on a farm.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Damage {
+    /// The largest peak contact pressure on the item \[kPa\].
+    pub peak_pressure_kpa: Option<f64>,
+    /// Whether any contact went above the item's bruise threshold.
+    pub bruised: Option<bool>,
+}
+
+impl Damage {
+    /// The CSV columns of [`Damage::cells`].
+    pub const HEADER: [&'static str; 2] = ["peak_pressure_kpa", "bruised"];
+
+    /// A run's damage, from its summary.
+    pub fn of(summary: &RunSummary) -> Damage {
+        let p = summary.produce.as_ref();
+        Damage { peak_pressure_kpa: p.map(|p| p.peak_pressure_kpa), bruised: p.map(|p| p.bruised) }
+    }
+
+    /// Whether the run bruised its item (never, for a rigid object).
+    pub fn is_bruised(&self) -> bool {
+        self.bruised == Some(true)
+    }
+
+    /// Its CSV cells (empty for a rigid object).
+    pub fn cells(&self) -> [String; 2] {
+        [cell(self.peak_pressure_kpa), self.bruised.map_or(String::new(), |b| b.to_string())]
+    }
+}
+
 /// Text of an optional number for a CSV cell (empty when absent).
 pub fn cell(v: Option<f64>) -> String {
     v.map_or(String::new(), |v| format!("{v}"))

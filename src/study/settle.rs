@@ -3,12 +3,12 @@
 //! bands and dwells (`[task.settled_grasp]`), each case over seeds, on the twin. One row per run
 //! (`settle.csv`), one per (object, grasp) (`settle_summary.csv`), a chart (`settle.png`), and the
 //! settled grasp the numbers recommend: the shortest mean cycle among those that held every object
-//! on every seed with no timeout.
+//! on every seed with no timeout and bruised no produce item.
 //!
 //! The objects are scenario files: a further object (a produce item) is studied by passing its
 //! scenario with `--scenario`, no code changed.
 
-use super::{cell, run_all, set, write_csv};
+use super::{Damage, cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
 use tendril_config::Override;
 use tendril_plot::panels::{Mark, Panel, Panels, Series};
@@ -89,6 +89,8 @@ pub struct SettleRun {
     pub grasp_s: Option<f64>,
     /// Largest fluctuation while the arm moved [%].
     pub fluctuation_pct: Option<f64>,
+    /// A produce item's damage (absent for a rigid object).
+    pub damage: Damage,
     /// The error that ended the run.
     pub error: Option<String>,
 }
@@ -112,6 +114,10 @@ pub struct SettleRow {
     pub grasp_mean_s: Option<f64>,
     /// Mean over the held runs of the largest fluctuation while moving [%].
     pub fluctuation_mean_pct: Option<f64>,
+    /// Runs that bruised their produce item (0 for a rigid object).
+    pub bruised: usize,
+    /// Mean of the runs' peak contact pressure on a produce item \[kPa\].
+    pub peak_pressure_mean_kpa: Option<f64>,
 }
 
 impl SettleRow {
@@ -166,6 +172,7 @@ pub fn run(
                 cycle_s: s.sim_time_s,
                 grasp_s,
                 fluctuation_pct: s.metrics.max_fluctuation_pct,
+                damage: Damage::of(&s),
                 error: s.error,
             });
         }
@@ -174,11 +181,22 @@ pub fn run(
     let csv = out.join("settle.csv");
     write_csv(
         &csv,
-        &["object", "grasp", "seed", "outcome", "cycle_s", "grasp_s", "fluctuation_pct", "error"],
+        &[
+            "object",
+            "grasp",
+            "seed",
+            "outcome",
+            "cycle_s",
+            "grasp_s",
+            "fluctuation_pct",
+            "peak_pressure_kpa",
+            "bruised",
+            "error",
+        ],
         &runs
             .iter()
             .map(|r| {
-                vec![
+                let mut cells = vec![
                     r.object.clone(),
                     r.grasp.label(),
                     r.seed.to_string(),
@@ -186,8 +204,10 @@ pub fn run(
                     format!("{}", r.cycle_s),
                     cell(r.grasp_s),
                     cell(r.fluctuation_pct),
-                    r.error.clone().unwrap_or_default(),
-                ]
+                ];
+                cells.extend(r.damage.cells());
+                cells.push(r.error.clone().unwrap_or_default());
+                cells
             })
             .collect::<Vec<_>>(),
     )?;
@@ -205,6 +225,8 @@ pub fn run(
             "cycle_mean_s",
             "grasp_mean_s",
             "fluctuation_mean_pct",
+            "bruised",
+            "peak_pressure_mean_kpa",
         ],
         &summary
             .iter()
@@ -219,6 +241,8 @@ pub fn run(
                     format!("{}", r.cycle_mean_s),
                     cell(r.grasp_mean_s),
                     cell(r.fluctuation_mean_pct),
+                    r.bruised.to_string(),
+                    cell(r.peak_pressure_mean_kpa),
                 ]
             })
             .collect::<Vec<_>>(),
@@ -251,6 +275,8 @@ fn aggregate(runs: &[SettleRun]) -> Vec<SettleRow> {
                 fluctuation_mean_pct: mean(
                     group.iter().filter(|r| r.outcome == "held").filter_map(|r| r.fluctuation_pct),
                 ),
+                bruised: group.iter().filter(|r| r.damage.is_bruised()).count(),
+                peak_pressure_mean_kpa: mean(group.iter().filter_map(|r| r.damage.peak_pressure_kpa)),
                 object,
             }
         })
@@ -290,7 +316,7 @@ fn chart(summary: &[SettleRow]) -> Panels {
 }
 
 /// The settled grasp with the shortest mean cycle (over the objects) among those that held every
-/// run of every object, said with its numbers against the paper's fixed 15 s.
+/// run of every object and bruised none, said with its numbers against the paper's fixed 15 s.
 pub fn recommend(summary: &[SettleRow]) -> String {
     let labels = tendril_plot::grid::first_seen(summary.iter().map(|r| r.grasp.label()));
     let of = |label: &str| summary.iter().filter(|r| r.grasp.label() == label).collect::<Vec<_>>();
@@ -299,11 +325,11 @@ pub fn recommend(summary: &[SettleRow]) -> String {
         .iter()
         .filter(|l| {
             let rows = of(l);
-            matches!(rows[0].grasp, Grasp::Settled { .. }) && rows.iter().all(|r| r.held == r.runs)
+            matches!(rows[0].grasp, Grasp::Settled { .. }) && rows.iter().all(|r| r.held == r.runs && r.bruised == 0)
         })
         .min_by(|a, b| cycle(&of(a)).total_cmp(&cycle(&of(b))));
     let Some(best) = best else {
-        return "recommended: none of the settled grasps held every run of every object".into();
+        return "recommended: none of the settled grasps held every run of every object without bruising it".into();
     };
     let rows = of(best);
     let mut text = format!("recommended: {best}: held every run, mean cycle {:.1} s", cycle(&rows));
@@ -315,4 +341,42 @@ pub fn recommend(summary: &[SettleRow]) -> String {
         text += &format!("; the paper's {paper}: held {held} of {runs}, mean cycle {:.1} s", cycle(&paper_rows));
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(object: &str, grasp: Grasp, held: usize, bruised: usize, cycle_mean_s: f64) -> SettleRow {
+        SettleRow {
+            object: object.into(),
+            grasp,
+            runs: 5,
+            held,
+            not_grasped: 0,
+            cycle_mean_s,
+            grasp_mean_s: None,
+            fluctuation_mean_pct: None,
+            bruised,
+            peak_pressure_mean_kpa: None,
+        }
+    }
+
+    #[test]
+    fn a_settled_grasp_that_bruises_a_produce_item_is_not_recommended() {
+        let quick = Grasp::Settled { band_pct: 15.0, dwell_s: 0.5 };
+        let slow = Grasp::Settled { band_pct: 15.0, dwell_s: 2.0 };
+        let mut summary = vec![
+            row("crimper", quick, 5, 0, 30.0),
+            row("cherry_tomato", quick, 5, 0, 30.0),
+            row("crimper", slow, 5, 0, 32.0),
+            row("cherry_tomato", slow, 5, 0, 32.0),
+        ];
+        assert!(recommend(&summary).starts_with("recommended: settled ±15 % for 0.5 s"), "{}", recommend(&summary));
+        // Held every run, but bruised one: the slower grasp is the one that keeps the fruit whole.
+        summary[1].bruised = 1;
+        assert!(recommend(&summary).starts_with("recommended: settled ±15 % for 2 s"), "{}", recommend(&summary));
+        summary[3].bruised = 2;
+        assert!(recommend(&summary).contains("none of the settled grasps"), "{}", recommend(&summary));
+    }
 }

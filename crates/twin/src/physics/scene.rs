@@ -651,16 +651,21 @@ impl Scene {
     /// The area of the finger's faces that touch the object now \[m²\]: each box of the finger
     /// (a strip link, a pad's casing) in contact with the object counts with its largest face
     /// (its length by the strip's width), once however many points touch. The area the wrap lies
-    /// on, at the links' resolution; a pad's bump counts through its casing.
+    /// on, at the links' resolution; a pad's bump counts through its casing. A produce item's
+    /// side of a contact is its flex.
     pub fn contact_area_m2(&self) -> f64 {
         let ids = &self.shared.ids;
         let m = &self.shared.model;
         let mut touching: Vec<usize> = Vec::new();
         for c in self.data.contact() {
-            let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
-            let finger = if ids.object_geoms.contains(&g2) { g1 } else { g2 };
-            let object = if finger == g1 { g2 } else { g1 };
-            if c.efc_address >= 0 && ids.object_geoms.contains(&object) && ids.finger_geoms.contains(&finger) {
+            let finger = match &ids.produce {
+                Some(p) => flex_contact(c, p.flex).map(|(g, _)| g),
+                None => {
+                    let (g1, g2) = (c.geom1 as usize, c.geom2 as usize);
+                    if ids.object_geoms.contains(&g2) { Some(g1) } else { ids.object_geoms.contains(&g1).then_some(g2) }
+                }
+            };
+            if let Some(finger) = finger.filter(|f| c.efc_address >= 0 && ids.finger_geoms.contains(f)) {
                 // The bump touches for its casing: one face per pad.
                 let face = if ids.pad_geoms.contains(&finger) { ids.pad_geoms[0] } else { finger };
                 if !touching.contains(&face) {
