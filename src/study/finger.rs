@@ -261,8 +261,8 @@ pub fn run(plan: &Plan, out: &Path, threads: usize) -> anyhow::Result<Outcome> {
             "peak_force_n",
             "peak_grip_n",
             "cycle_s",
-            "peak_pressure_kpa",
-            "bruised",
+            Damage::HEADER[0],
+            Damage::HEADER[1],
             "error",
         ],
         &cases

@@ -108,7 +108,7 @@ pub struct Damage {
 }
 
 impl Damage {
-    /// The CSV columns of [`Damage::cells`].
+    /// The CSV columns of [`Damage::cells`], in their order (each study's run CSV names them here).
     pub const HEADER: [&'static str; 2] = ["peak_pressure_kpa", "bruised"];
 
     /// A run's damage, from its summary.

@@ -189,8 +189,8 @@ pub fn run(
             "cycle_s",
             "grasp_s",
             "fluctuation_pct",
-            "peak_pressure_kpa",
-            "bruised",
+            Damage::HEADER[0],
+            Damage::HEADER[1],
             "error",
         ],
         &runs
