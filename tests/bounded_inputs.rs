@@ -94,6 +94,15 @@ fn a_fine_zone_must_start_on_the_strip_before_the_pad() {
 }
 
 #[test]
+fn the_clamp_s_joint_takes_only_its_two_names() {
+    let err = load(&["finger.base_joint=\"half\""]).unwrap_err().to_string();
+    assert!(err.contains("finger.base_joint") && err.contains("whole_link") && err.contains("half_link"), "{err}");
+    for ok in ["whole_link", "half_link"] {
+        assert!(load(&[&format!("finger.base_joint=\"{ok}\"")]).is_ok(), "{ok}");
+    }
+}
+
+#[test]
 fn any_u64_seed_is_accepted_through_set_and_the_file() {
     assert_eq!(load(&["seed=18446744073709551615"]).unwrap().seed, u64::MAX);
     assert_eq!(load(&["seed=\"18446744073709551615\""]).unwrap().seed, u64::MAX);

@@ -80,3 +80,40 @@ fn the_default_converges_against_step_over_two_and_links_times_two() {
     let out = tendril(&["chart", "convergence", "--quick", "--seeds", "1", "--out", dir.path().to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
 }
+
+/// The pinch's first-order error is the clamp's joint (models/README.md, "Where the pinch's first
+/// order came from"): the crimper without feedback (seed 1), its drop at the default links and at
+/// links ×2, with the clamp's joint standing for the whole first link (the default) and for its
+/// half (the Hencky chain's). Four runs, about 10 s of CPU.
+#[test]
+fn the_clamp_s_half_link_takes_the_links_out_of_the_crimper_s_drop() {
+    let dir = tempfile::tempdir().unwrap();
+    let drop_s = |base_joint: &str, segments: u32| -> f64 {
+        let out_dir = dir.path().join(format!("{base_joint}-{segments}"));
+        let out = tendril(&[
+            "run",
+            "scenarios/crimper.toml",
+            "--feedback",
+            "off",
+            "--seed",
+            "1",
+            "--set",
+            &format!("finger.base_joint=\"{base_joint}\""),
+            "--set",
+            &format!("finger.segments={segments}"),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(summary["outcome"], "dropped", "{base_joint} at {segments} links: {summary}");
+        summary["drop_time_s"].as_f64().unwrap()
+    };
+    let (half, half_x2) = (drop_s("half_link", 8), drop_s("half_link", 16));
+    let (whole, whole_x2) = (drop_s("whole_link", 8), drop_s("whole_link", 16));
+    // Measured: half 9.26 / 9.27 s, whole 10.14 / 9.82 s. The half link's step is the seeds' own
+    // scatter (up to 0.07 s); the whole link's is the first-order error the default carries.
+    assert!((half - half_x2).abs() < 0.1, "half_link: {half} s at 8 links, {half_x2} s at 16");
+    assert!(whole - whole_x2 > 0.2, "whole_link: {whole} s at 8 links, {whole_x2} s at 16");
+}

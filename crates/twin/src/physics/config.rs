@@ -377,6 +377,17 @@ impl Validate for PhysicsConfig {
     }
 }
 
+/// How much strip the joint at the strip's base stands for (`finger.base_joint`): the
+/// discretisation's clamp.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaseJoint {
+    /// The whole first link: the joint's stiffness is `EI / l` for the first link's length `l`.
+    WholeLink,
+    /// The half of the first link beside the clamp (the Hencky bar-chain's): `2 EI / l`.
+    HalfLink,
+}
+
 /// `[finger]`: the grow-and-twine finger's physical parameters (models/finger.xml is the template).
 ///
 /// Nothing about the real finger's dimensions is published (docs/facts.md#gripper-dimensions-are-unpublished); the values are plausible
@@ -398,8 +409,8 @@ pub struct FingerConfig {
     /// How many times finer than `segments` implies the links are between the strip's base and the
     /// pad's casing (1: a uniform grid). A numerical choice, like `segments`: that stretch holds the
     /// pinch between palm and strip where the wrap starts, which carries most of an object held
-    /// without feedback and converges only at first order in the link length there (models/README.md,
-    /// "What still moves with the links"), so it gets the 2.2 mm links the uniform finger needed
+    /// without feedback and converges only at first order in the link length there with the default
+    /// clamp (`base_joint`; models/README.md, "What still moves with the links"), so it gets the 2.2 mm links the uniform finger needed
     /// there, while the distal stretch, whose loads change slowly, keeps coarse ones. Doubling
     /// `segments` halves both grids.
     pub base_refinement: u32,
@@ -411,6 +422,18 @@ pub struct FingerConfig {
     /// moved every drop by 1.2-3.3 s (docs/studies/levers.md, lever 2). Check any other value with
     /// `tendril chart convergence --quick --set finger.fine_from_m=...`.
     pub fine_from_m: f64,
+    /// How much strip the joint at the strip's base (the guide's exit, where the grown strip is
+    /// clamped) stands for: `"whole_link"` (the default: the whole first link, so that joint is
+    /// half as stiff as the next ones for the same length) or `"half_link"` (the Hencky bar-chain's
+    /// clamp: the half of the first link beside it, so it gets `2 EI / l`). A numerical choice of
+    /// the discretisation. `"whole_link"` adds a compliance of half a link at the clamp, an error of
+    /// first order in the base links' length, and that is the pinch's first-order error. With
+    /// `"half_link"` links ×2 moves the three drops without feedback by 0.01-0.08 s (seeds 1-3),
+    /// with `"whole_link"` by 0.27-0.41 s (the crimper's 10.14 s to 9.82 s; models/README.md,
+    /// "Where the pinch's first order came from"). The default stays `"whole_link"` until the
+    /// creep's calibration and the book's studies are redone on `"half_link"`, which moves the
+    /// default's drops 0.5-1.1 s earlier.
+    pub base_joint: BaseJoint,
     /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
     /// Strip thickness \[m\] (capsule diameter). 2 mm: a choice for a TPU strip with a tendon channel.
@@ -520,6 +543,7 @@ impl Default for FingerConfig {
             segments: 8,
             base_refinement: 8,
             fine_from_m: 0.0,
+            base_joint: BaseJoint::WholeLink,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,

@@ -52,7 +52,8 @@ pub mod validation;
 pub use census::{ContactCensus, PairTally};
 pub use compose::Placement;
 pub use config::{
-    ArmMode, Backend, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig, Solver,
+    ArmMode, Backend, BaseJoint, Cone, FingerConfig, Integrator, ObjectConfig, ObjectName, PhysicsConfig, RapierConfig,
+    Solver,
 };
 pub use engine::Physics;
 pub use error::{Divergence, PhysicsError};

@@ -7,7 +7,7 @@
 //! edges are joints at any number of links, and the uniform grid of `finger.segments` links cuts
 //! only the flexible stretches between them.
 
-use super::config::FingerConfig;
+use super::config::{BaseJoint, FingerConfig};
 
 /// Half the sensor pad's casing length \[m\] (12 mm casing, paper Sec. II).
 pub const PAD_HALF_LENGTH_M: f64 = 0.006;
@@ -87,9 +87,15 @@ pub fn layout_with_pads(f: &FingerConfig, extra_pads_m: &[f64]) -> Vec<Piece> {
             Piece { start_m: start, length_m: end - start, fixed: fixed(start), joint_span_m: 0.0 }
         })
         .collect();
+    let flex = |p: &Piece| if p.fixed { 0.0 } else { p.length_m / 2.0 };
+    // The clamp: no strip lies before the base's joint, so the Hencky chain gives it the first
+    // link's half alone; `WholeLink` counts that half twice (`finger.base_joint`).
+    let at_clamp = match f.base_joint {
+        BaseJoint::WholeLink => flex(&pieces[0]),
+        BaseJoint::HalfLink => 0.0,
+    };
     for k in 0..pieces.len() {
-        let flex = |p: &Piece| if p.fixed { 0.0 } else { p.length_m / 2.0 };
-        let before = if k == 0 { flex(&pieces[0]) } else { flex(&pieces[k - 1]) };
+        let before = if k == 0 { at_clamp } else { flex(&pieces[k - 1]) };
         pieces[k].joint_span_m = before + flex(&pieces[k]);
     }
     pieces
@@ -197,6 +203,22 @@ mod tests {
         assert_eq!(pieces.len(), 30);
         let uniform = layout(&FingerConfig { segments: 64, base_refinement: 1, ..f });
         assert_eq!(uniform.len(), 55);
+    }
+
+    #[test]
+    fn the_clamp_s_joint_stands_for_the_first_link_or_its_half_and_no_other_joint_moves() {
+        for f in [FingerConfig::default(), FingerConfig { segments: 32, base_refinement: 1, ..FingerConfig::default() }]
+        {
+            let whole = layout(&f);
+            let half = layout(&FingerConfig { base_joint: BaseJoint::HalfLink, ..f.clone() });
+            let first = whole[0].length_m;
+            assert!((whole[0].joint_span_m - first).abs() < 1e-15, "{:?}", whole[0]);
+            assert!((half[0].joint_span_m - first / 2.0).abs() < 1e-15, "{:?}", half[0]);
+            // Every joint but the clamp's spans half of each flexible neighbour under both.
+            assert_eq!(whole[1..], half[1..]);
+            let (a, b) = (whole[1], whole[2]);
+            assert!((b.joint_span_m - (a.length_m + b.length_m) / 2.0).abs() < 1e-15, "{b:?}");
+        }
     }
 
     #[test]
