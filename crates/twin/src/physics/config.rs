@@ -409,10 +409,10 @@ pub struct FingerConfig {
     /// How many times finer than `segments` implies the links are between the strip's base and the
     /// pad's casing (1: a uniform grid). A numerical choice, like `segments`: that stretch holds the
     /// pinch between palm and strip where the wrap starts, which carries most of an object held
-    /// without feedback and converges only at first order in the link length there with the default
-    /// clamp (`base_joint`; models/README.md, "What still moves with the links"), so it gets the 2.2 mm links the uniform finger needed
-    /// there, while the distal stretch, whose loads change slowly, keeps coarse ones. Doubling
-    /// `segments` halves both grids.
+    /// without feedback and converges only at first order in the link length there with the
+    /// default clamp (`base_joint`; models/README.md, "What still moves with the links"), so it
+    /// gets the 2.2 mm links the uniform finger needed there, while the distal stretch, whose
+    /// loads change slowly, keeps coarse ones. Doubling `segments` halves both grids.
     pub base_refinement: u32,
     /// Arc length from the strip's base where the fine grid of `base_refinement` starts \[m\]; the
     /// strip below it keeps the coarse links of `segments`. 0 (the default): the fine grid runs
