@@ -33,6 +33,18 @@ fn every_shipped_object_exports_a_complete_scene_with_its_start_keyframe() {
 }
 
 #[test]
+fn a_produce_item_exports_its_flex_where_the_run_starts_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = export(dir.path(), "scenarios/cherry-tomato.toml", &["--set", "produce.poisson=0.4"]);
+    let xml = std::fs::read_to_string(&path).unwrap();
+    assert!(xml.contains("<body name=\"produce_frame\" pos=") && xml.contains("<flexcomp name=\"produce\""));
+    // The scenario's override is in the flex's elasticity, and MuJoCo compiles the whole.
+    assert!(xml.contains("poisson=\"0.4\""), "the override is not in the flex");
+    let model = mujoco_rs::prelude::MjModel::from_xml(&path).unwrap();
+    assert_eq!((model.ffi().nflex, model.ffi().nkey), (1, 1));
+}
+
+#[test]
 fn a_friction_override_is_written_into_the_exported_grip() {
     let dir = tempfile::tempdir().unwrap();
     let path = export(dir.path(), "scenarios/crimper.toml", &["--set", "object.friction=1.3"]);

@@ -3,7 +3,9 @@
 //! [`SceneModel::build`] applies to the compiled model written into the text instead (the object's
 //! start pose and yaw on the table, grip-friction and mass overrides, the kinematic arm's armature), plus a
 //! keyframe `start` holding the start state (arm at its home angles, finger retracted, object
-//! standing where the run starts it).
+//! standing where the run starts it). A produce item's flex is in the text as the run builds it
+//! (its elasticity and calibrated contact included); a harvest's stem is not, since the run
+//! applies it as a force of its own (`produce_run`).
 //!
 //! The export checks itself: the text is compiled again and its model must match the one the runs
 //! use in every value the edits touch, so a model file the edits do not recognise is an error, not
@@ -22,7 +24,10 @@ const ARM_JOINTS: [&str; 6] = ["shoulder_pan", "shoulder_lift", "elbow", "wrist_
 pub fn standalone_xml(model: &Arc<SceneModel>) -> Result<String, PhysicsError> {
     let spec = model.spec();
     let mut xml = model.xml().to_string();
-    if let (Some(obj), Some(p)) = (&spec.object, model.placement().object) {
+    // A produce item's flex is written where it starts, with its mass and friction, by the
+    // scene itself (its frame's `pos`); only a rigid object's body needs the edits.
+    let rigid = model.produce().is_none();
+    if let (Some(obj), Some(p), true) = (&spec.object, model.placement().object, rigid) {
         xml = set_attribute(&xml, "<body name=\"object\"", "pos", &nums(&[p.x, p.y, p.z]))?;
         if let Some(yaw) = obj.yaw_deg {
             xml = set_attribute(&xml, "<body name=\"object\"", "quat", &nums(&yaw_quaternion(yaw)))?;
