@@ -152,6 +152,28 @@ fn write_speed_accuracy(dir: &Path) {
     std::fs::write(dir.join("speed_accuracy.csv"), s).unwrap();
 }
 
+/// A produce item's study: the flex's columns, colour by its degrees of freedom.
+#[test]
+fn a_produce_item_s_speed_accuracy_rows_carry_their_flex_and_draw_by_it() {
+    let (_keep, dir) = workdir("speed_produce");
+    let head = "backend,integrator,cone,solver,timestep_s,segments,base_refinement,fine_from_m,sim_s_per_cpu_s,\
+                force_rmse_n,drop_time_error_s,status,is_default,is_reference,produce_grid,produce_dof,peak_pressure_error_pct";
+    let rows = [
+        "mujoco,discrete,elliptic,newton,0.000625,16,8,0,0.3,0,0,ok,false,true,13,quadratic,0",
+        "mujoco,discrete,elliptic,newton,0.0025,8,8,0,4.0,0.2,,ok,true,false,7,trilinear,20.5",
+        "mujoco,discrete,elliptic,newton,0.0025,8,8,0,2.0,0.05,0.1,ok,false,false,7,quadratic,3.1",
+        "mujoco,discrete,elliptic,cg,0.0025,8,8,0,4.5,0.21,,ok,false,false,7,trilinear,",
+    ];
+    std::fs::write(dir.join("speed_accuracy.csv"), format!("{head}\n{}\n", rows.join("\n"))).unwrap();
+    let rows = plot::speed_accuracy::read(&dir.join("speed_accuracy.csv")).unwrap();
+    assert_eq!(rows[1].produce_grid, Some(7));
+    assert_eq!(rows[2].produce_dof.as_deref(), Some("quadratic"));
+    assert_eq!((rows[1].peak_pressure_error_pct, rows[3].peak_pressure_error_pct), (Some(20.5), None));
+    plot::speed_accuracy::render(&rows, &dir).unwrap();
+    let svg = std::fs::read_to_string(dir.join("speed_accuracy.svg")).unwrap();
+    assert!(svg.contains("trilinear flex + CG") && svg.contains("quadratic flex") && svg.contains("7 pts"), "{svg}");
+}
+
 fn write_stability(dir: &Path, backends: &[&str]) {
     let mut s = String::from("backend,integrator,timestep_s,outcome\n");
     let limits = [("Euler", 1e-3), ("implicitfast", 5e-3), ("implicit", 1e-2), ("RK4", 2e-3)];

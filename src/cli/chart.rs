@@ -25,7 +25,7 @@ pub struct ChartArgs {
     #[arg(value_parser = ["convergence", "speed-accuracy", "stability", "gain-map", "controllers", "jitter", "placement", "settle", "detector", "finger", "hold", "produce"])]
     study: String,
     /// Scenario to study [default: convergence, gain-map, controllers, placement and settle the three objects; speed-accuracy the crimper (its fine reference drops it too, so
-    /// drop times compare), stability the hammer (the heaviest load)].
+    /// drop times compare; a produce item's study varies its flex's grid and degrees of freedom), stability the hammer (the heaviest load)].
     #[arg(long)]
     scenario: Vec<PathBuf>,
     /// Output folder [default: out/<study>].
@@ -108,8 +108,17 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             return Ok(if converged { ExitCode::SUCCESS } else { ExitCode::FAILURE });
         }
         "speed-accuracy" => {
-            let grid = if a.quick { study::speed_accuracy::Grid::quick() } else { study::speed_accuracy::Grid::full() };
-            study::speed_accuracy::run(&first("scenarios/crimper.toml"), &grid, &out, a.threads)?
+            use study::speed_accuracy::{Grid, ProduceGrid, run, run_produce};
+            let scenario = first("scenarios/crimper.toml");
+            // A produce item's study varies its flex instead of the integrator and the cone.
+            let loaded: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&scenario, &[])?;
+            match study::convergence::FlexSetting::of(&loaded)? {
+                Some(flex) => {
+                    let grid = if a.quick { ProduceGrid::quick(flex) } else { ProduceGrid::full(flex) };
+                    run_produce(&scenario, &grid, &out, a.threads)?
+                }
+                None => run(&scenario, &if a.quick { Grid::quick() } else { Grid::full() }, &out, a.threads)?,
+            }
         }
         "stability" => {
             let steps: &[f64] = if a.quick { &[0.005, 0.04] } else { &study::stability::TIMESTEPS_S };

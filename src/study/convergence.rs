@@ -67,6 +67,17 @@ pub struct FlexSetting {
     pub dof: tendril_twin::physics::Dof,
 }
 
+impl FlexSetting {
+    /// The flex of `scenario` as loaded (its `[produce]` or the item's file); None for a rigid
+    /// object.
+    pub fn of(scenario: &tendril_run::scenario::PickPlaceScenario) -> anyhow::Result<Option<FlexSetting>> {
+        Ok(scenario.object.model()?.produce.map(|item| FlexSetting {
+            count: scenario.produce.count.unwrap_or(item.count[0]),
+            dof: scenario.produce.dof.unwrap_or(item.dof),
+        }))
+    }
+}
+
 /// One numerical setting: a timestep and a number of finger links.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Setting {
@@ -178,13 +189,13 @@ impl Plan {
         finest_timestep_s: f64,
     ) -> anyhow::Result<Plan> {
         let (dt, links) = (scenario.physics.timestep_s, scenario.finger.segments);
-        Ok(match scenario.object.model()?.produce {
-            Some(item) => {
-                let flex = FlexSetting {
-                    count: scenario.produce.count.unwrap_or(item.count[0]),
-                    dof: scenario.produce.dof.unwrap_or(item.dof),
-                };
-                if quick { Plan::produce_quick(dt, links, flex) } else { Plan::produce(dt, links, flex) }
+        Ok(match FlexSetting::of(scenario)? {
+            Some(flex) => {
+                if quick {
+                    Plan::produce_quick(dt, links, flex)
+                } else {
+                    Plan::produce(dt, links, flex)
+                }
             }
             None if quick => Plan::quick(dt, links),
             None => Plan::full(dt, links, finest_timestep_s),

@@ -1,6 +1,9 @@
 //! Speed against accuracy: one scenario over timestep × integrator × friction cone × finger
 //! links on MuJoCo, and timestep × solver iterations × finger links on rapier, each compared
-//! with one reference run (MuJoCo, smallest timestep, finest finger).
+//! with one reference run (MuJoCo, smallest timestep, finest finger). A produce item's study
+//! ([`ProduceGrid`]) varies its flex's grid and degrees of freedom instead of the integrator and
+//! the cone (a flex runs on MuJoCo's discrete integrator only), and adds the peak contact
+//! pressure's error.
 //!
 //! Accuracy is the RMS difference of the true sensor-force trace from the reference's, tick by
 //! tick while the object should be held, and the drop-time difference. The runs are made without
@@ -8,11 +11,11 @@
 //! seconds per CPU second of the thread that ran it (`RunSummary::sim_s_per_cpu_s`), so runs can
 //! share the machine without changing each other's speed.
 
-use super::convergence::force_rmse;
+use super::convergence::{FlexSetting, force_rmse};
 use super::{cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
 use tendril_plot::speed_accuracy::{SpeedAccuracyRow, render};
-use tendril_twin::physics::{FingerConfig, PhysicsConfig};
+use tendril_twin::physics::{Dof, FingerConfig, PhysicsConfig};
 
 /// The grid of a speed/accuracy study.
 #[derive(Debug, Clone)]
@@ -82,6 +85,107 @@ impl Grid {
             solvers: vec![],
         }
     }
+
+    /// Every point, the reference first.
+    fn points(&self) -> Vec<Point> {
+        let grid = self;
+        let mut labels = vec![Point::mujoco(grid.reference.0, "implicitfast", "elliptic", grid.reference.1)];
+        for &dt in &grid.timesteps_s {
+            for &segments in &grid.segments {
+                for &integrator in &grid.integrators {
+                    for &cone in &grid.cones {
+                        labels.push(Point::mujoco(dt, integrator, cone, segments));
+                    }
+                }
+                for &solver in &grid.solvers {
+                    labels.push(Point { solver, ..Point::mujoco(dt, "implicitfast", "elliptic", segments) });
+                }
+                if grid.rapier_timesteps_s.contains(&dt) && grid.rapier_segments.contains(&segments) {
+                    labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
+                }
+            }
+            labels.extend(
+                grid.graded
+                    .iter()
+                    .map(|&(segments, refinement, from_m)| Point::graded(dt, segments, refinement, from_m)),
+            );
+        }
+        labels
+    }
+}
+
+/// The grid of a produce item's speed/accuracy study: the step × the finger's links × the flex's
+/// grid and degrees of freedom, on MuJoCo's discrete integrator (the one a flex runs on) with
+/// elliptic cones, against one reference, the finest of each.
+#[derive(Debug, Clone)]
+pub struct ProduceGrid {
+    /// Timesteps \[s\].
+    pub timesteps_s: Vec<f64>,
+    /// Finger links (`finger.segments`; the default base refinement kept, as the convergence
+    /// study's links ×2 keeps it).
+    pub segments: Vec<u32>,
+    /// The flex's grids and degrees of freedom.
+    pub flexes: Vec<FlexSetting>,
+    /// Other MuJoCo constraint solvers (`physics.solver`), each run at every timestep with the
+    /// default links and flex.
+    pub solvers: Vec<&'static str>,
+    /// The reference: timestep \[s\], links and flex.
+    pub reference: (f64, u32, FlexSetting),
+    /// The item's own flex (the scenario's), ringed as the default with the project's step and
+    /// links.
+    pub default_flex: FlexSetting,
+}
+
+impl ProduceGrid {
+    /// The full study around the item's flex `flex` (23 runs for a trilinear flex of 7 points):
+    /// the step at 2.5 and 1.25 ms, 8 and 16 links, the grid coarser (5 points), as given and
+    /// refined (twice the intervals), trilinear and quadratic, and the CG solver, against the
+    /// refined quadratic flex at 0.625 ms and 16 links.
+    pub fn full(flex: FlexSetting) -> ProduceGrid {
+        let (coarse, fine) = (flex.count.saturating_sub(2).max(3), 2 * flex.count - 1);
+        let at = |count: u32, dof: Dof| FlexSetting { count, dof };
+        let mut flexes = vec![at(coarse, Dof::Trilinear), at(flex.count, Dof::Trilinear), at(fine, Dof::Trilinear)];
+        flexes.extend([at(flex.count, Dof::Quadratic), at(fine, Dof::Quadratic)]);
+        ProduceGrid {
+            timesteps_s: vec![0.0025, 0.00125],
+            segments: vec![8, 16],
+            flexes,
+            solvers: vec!["cg"],
+            reference: (0.000625, 16, at(fine, Dof::Quadratic)),
+            default_flex: flex,
+        }
+    }
+
+    /// A small grid for a quick look: the item's flex and its quadratic form at 2.5 ms and 8
+    /// links, against the same flex at 1.25 ms.
+    pub fn quick(flex: FlexSetting) -> ProduceGrid {
+        ProduceGrid {
+            timesteps_s: vec![0.0025],
+            segments: vec![8],
+            flexes: vec![flex, FlexSetting { dof: Dof::Quadratic, ..flex }],
+            solvers: vec![],
+            reference: (0.00125, 8, flex),
+            default_flex: flex,
+        }
+    }
+
+    /// Every point, the reference first.
+    fn points(&self) -> Vec<Point> {
+        let default_links = FingerConfig::default().segments;
+        let (dt, links, flex) = self.reference;
+        let mut points = vec![Point::produce(dt, links, flex)];
+        for &dt in &self.timesteps_s {
+            for &links in &self.segments {
+                points.extend(self.flexes.iter().map(|&flex| Point::produce(dt, links, flex)));
+            }
+            points.extend(
+                self.solvers
+                    .iter()
+                    .map(|&solver| Point { solver, ..Point::produce(dt, default_links, self.default_flex) }),
+            );
+        }
+        points
+    }
 }
 
 /// One point of the grid: the backend's own axes (MuJoCo: integrator and cone; rapier: solver
@@ -96,6 +200,8 @@ struct Point {
     fine_from_m: f64,
     solver: &'static str,
     rapier_iterations: Option<u32>,
+    /// A produce item's flex (None for a rigid object).
+    flex: Option<FlexSetting>,
 }
 
 impl Point {
@@ -109,6 +215,7 @@ impl Point {
             fine_from_m: 0.0,
             solver: "newton",
             rapier_iterations: None,
+            flex: None,
         }
     }
 
@@ -118,10 +225,22 @@ impl Point {
         Point { base_refinement, fine_from_m, ..Point::mujoco(timestep_s, "implicitfast", "elliptic", segments) }
     }
 
-    /// The project's default settings (`PhysicsConfig` and `FingerConfig` defaults).
-    fn project_default() -> Point {
+    /// A produce item's point: `segments` links (the default base refinement), the flex `flex`,
+    /// the discrete integrator and elliptic cones.
+    fn produce(timestep_s: f64, segments: u32, flex: FlexSetting) -> Point {
+        let f = FingerConfig::default();
+        let graded = Point::graded(timestep_s, segments, f.base_refinement, f.fine_from_m);
+        Point { integrator: "discrete".into(), flex: Some(flex), ..graded }
+    }
+
+    /// The project's default settings (`PhysicsConfig` and `FingerConfig` defaults; for a
+    /// produce item, with its flex `flex`).
+    fn project_default(flex: Option<FlexSetting>) -> Point {
         let (p, f) = (PhysicsConfig::default(), FingerConfig::default());
-        Point::graded(p.timestep_s, f.segments, f.base_refinement, f.fine_from_m)
+        match flex {
+            Some(flex) => Point::produce(p.timestep_s, f.segments, flex),
+            None => Point::graded(p.timestep_s, f.segments, f.base_refinement, f.fine_from_m),
+        }
     }
 
     fn rapier(timestep_s: f64, iterations: u32, segments: u32) -> Point {
@@ -134,6 +253,7 @@ impl Point {
             fine_from_m: 0.0,
             solver: "pgs",
             rapier_iterations: Some(iterations),
+            flex: None,
         }
     }
 
@@ -153,6 +273,9 @@ impl Point {
             ]),
             Some(it) => o.extend([set("physics.backend", "\"rapier\""), set("physics.rapier.solver_iterations", it)]),
         }
+        if let Some(f) = self.flex {
+            o.extend([set("produce.count", f.count), set("produce.dof", format!("\"{}\"", f.dof.name()))]);
+        }
         o
     }
 }
@@ -161,36 +284,39 @@ impl Point {
 /// project's default settings ringed; `threads` runs at once (speed is each run's own CPU time).
 /// Returns the files written.
 pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
-    let mut labels = vec![Point::mujoco(grid.reference.0, "implicitfast", "elliptic", grid.reference.1)];
-    for &dt in &grid.timesteps_s {
-        for &segments in &grid.segments {
-            for &integrator in &grid.integrators {
-                for &cone in &grid.cones {
-                    labels.push(Point::mujoco(dt, integrator, cone, segments));
-                }
-            }
-            for &solver in &grid.solvers {
-                labels.push(Point { solver, ..Point::mujoco(dt, "implicitfast", "elliptic", segments) });
-            }
-            if grid.rapier_timesteps_s.contains(&dt) && grid.rapier_segments.contains(&segments) {
-                labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
-            }
-        }
-        labels.extend(
-            grid.graded.iter().map(|&(segments, refinement, from_m)| Point::graded(dt, segments, refinement, from_m)),
-        );
-    }
-    let default = Point::project_default();
+    measure(scenario, &grid.points(), &Point::project_default(None), out, threads)
+}
+
+/// Runs a produce item's study ([`ProduceGrid`]) on `scenario` and writes the same files, with
+/// the flex's columns and the peak pressure's error.
+pub fn run_produce(scenario: &Path, grid: &ProduceGrid, out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
+    measure(scenario, &grid.points(), &Point::project_default(Some(grid.default_flex)), out, threads)
+}
+
+/// Runs `labels` (the reference first) on `scenario`, `threads` at once, and writes
+/// `speed_accuracy.csv` and its chart into `out`, `default` ringed.
+fn measure(
+    scenario: &Path,
+    labels: &[Point],
+    default: &Point,
+    out: &Path,
+    threads: usize,
+) -> anyhow::Result<Vec<PathBuf>> {
     let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), threads)?;
     let reference = &runs[0];
     let rows: Vec<SpeedAccuracyRow> = runs
         .iter()
-        .zip(&labels)
+        .zip(labels)
         .enumerate()
         .map(|(i, (r, point))| {
             let ok = r.summary.outcome != "error";
             let drop_error = match (r.summary.drop_time_s, reference.summary.drop_time_s) {
                 (Some(a), Some(b)) => Some((a - b).abs()),
+                _ => None,
+            };
+            let peak = |r: &super::StudyRun| r.summary.produce.as_ref().map(|p| p.peak_pressure_kpa);
+            let pressure_error = match (peak(r), peak(reference)) {
+                (Some(a), Some(b)) if ok && b > 0.0 => Some(100.0 * (a - b).abs() / b),
                 _ => None,
             };
             SpeedAccuracyRow {
@@ -211,8 +337,11 @@ pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::
                     None
                 },
                 drop_time_error_s: if ok { drop_error } else { None },
+                produce_grid: point.flex.map(|f| f.count),
+                produce_dof: point.flex.map(|f| f.dof.name().to_string()),
+                peak_pressure_error_pct: pressure_error,
                 status: if ok { "ok".into() } else { "diverged".into() },
-                is_default: *point == default && i != 0,
+                is_default: point == default && i != 0,
                 is_reference: i == 0,
             }
         })
@@ -234,6 +363,9 @@ pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::
         "status",
         "is_default",
         "is_reference",
+        "produce_grid",
+        "produce_dof",
+        "peak_pressure_error_pct",
     ];
     let cells: Vec<Vec<String>> = rows
         .iter()
@@ -253,6 +385,9 @@ pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::
                 r.status.clone(),
                 r.is_default.to_string(),
                 r.is_reference.to_string(),
+                r.produce_grid.map_or(String::new(), |n| n.to_string()),
+                r.produce_dof.clone().unwrap_or_default(),
+                cell(r.peak_pressure_error_pct),
             ]
         })
         .collect();
@@ -260,4 +395,28 @@ pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::
     let mut files = vec![csv];
     files.extend(render(&rows, out)?);
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_produce_grid_holds_its_default_once_and_runs_every_point_on_the_discrete_integrator() {
+        let flex = FlexSetting { count: 7, dof: Dof::Trilinear };
+        let points = ProduceGrid::full(flex).points();
+        // 2 steps × 2 links × 5 flexes, the CG solver at each step, and the reference.
+        assert_eq!(points.len(), 23);
+        assert_eq!(points[0], Point::produce(0.000625, 16, FlexSetting { count: 13, dof: Dof::Quadratic }));
+        let default = Point::project_default(Some(flex));
+        assert_eq!(points.iter().filter(|p| **p == default).count(), 1);
+        for p in &points {
+            let o = p.overrides();
+            let value = |key: &str| o.iter().find(|o| o.key == key).map(|o| o.value.clone());
+            assert_eq!(value("physics.integrator"), Some(toml::Value::String("discrete".into())), "{p:?}");
+            assert!(value("produce.count").is_some() && value("produce.dof").is_some(), "{p:?}");
+        }
+        // A rigid object's grid never sets the flex.
+        assert!(Grid::quick().points().iter().all(|p| p.flex.is_none()));
+    }
 }

@@ -37,6 +37,15 @@ pub struct SpeedAccuracyRow {
     pub force_rmse_n: Option<f64>,
     /// Drop-time error against the reference \[s\] (None when neither dropped).
     pub drop_time_error_s: Option<f64>,
+    /// A produce item's flex: points per axis of its grid (None for a rigid object, or when the
+    /// file has no such column).
+    pub produce_grid: Option<u32>,
+    /// A produce item's flex: its degrees of freedom ("trilinear", "quadratic"; None for a rigid
+    /// object).
+    pub produce_dof: Option<String>,
+    /// A produce item: the peak contact pressure's difference from the reference's, in percent of
+    /// the reference's (None for a rigid object).
+    pub peak_pressure_error_pct: Option<f64>,
     /// "ok", "diverged" or "error".
     pub status: String,
     /// These are the scenario's default settings.
@@ -56,6 +65,8 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
     let (default, reference) = (c("is_default")?, c("is_reference")?);
     let (solver, refinement) = (t.optional_column("solver"), t.optional_column("base_refinement"));
     let fine_from = t.optional_column("fine_from_m");
+    let (grid, dof) = (t.optional_column("produce_grid"), t.optional_column("produce_dof"));
+    let pressure = t.optional_column("peak_pressure_error_pct");
     let rows = t
         .iter()
         .map(|r| {
@@ -78,6 +89,15 @@ pub fn read(path: &Path) -> Result<Vec<SpeedAccuracyRow>, PlotError> {
                 sim_s_per_cpu_s: r.opt_f64(speed)?,
                 force_rmse_n: r.opt_f64(rmse)?,
                 drop_time_error_s: r.opt_f64(drop)?,
+                produce_grid: match grid.map(|c| r.text(c)).filter(|t| !t.is_empty()) {
+                    Some(text) => Some(whole(&r, "produce_grid", text)?),
+                    None => None,
+                },
+                produce_dof: dof.map(|c| r.text(c)).filter(|t| !t.is_empty()).map(str::to_string),
+                peak_pressure_error_pct: match pressure {
+                    Some(c) => r.opt_f64(c)?,
+                    None => None,
+                },
                 status: r.one_of(status, &["ok", "diverged", "error"])?,
                 is_default: r.bool(default)?,
                 is_reference: r.bool(reference)?,
@@ -125,14 +145,15 @@ struct SpeedAccuracy {
     rows: Vec<SpeedAccuracyRow>,
 }
 
-/// The colour series a row belongs to: its integrator, and on MuJoCo its solver when that is not
-/// the default Newton (rapier's integrator column already names its solver).
+/// The colour series a row belongs to: its integrator (a produce item's: its flex's degrees of
+/// freedom, since its integrator is always MuJoCo's discrete one), and on MuJoCo its solver when
+/// that is not the default Newton (rapier's integrator column already names its solver).
 fn series(r: &SpeedAccuracyRow) -> String {
-    if r.backend == "mujoco" && r.solver != "newton" {
-        format!("{} + {}", r.integrator, r.solver.to_uppercase())
-    } else {
-        r.integrator.clone()
-    }
+    let base = match &r.produce_dof {
+        Some(dof) => format!("{dof} flex"),
+        None => r.integrator.clone(),
+    };
+    if r.backend == "mujoco" && r.solver != "newton" { format!("{base} + {}", r.solver.to_uppercase()) } else { base }
 }
 
 /// Short description of a row's settings, for labels.
@@ -142,7 +163,12 @@ fn settings(r: &SpeedAccuracyRow) -> String {
         (true, false) => format!(" (base x{})", r.base_refinement),
         _ => String::new(),
     };
-    format!("{}, {} links{graded}, {}", style::timestep(r.timestep_s), r.segments, r.cone)
+    let flex = match (r.produce_grid, &r.produce_dof) {
+        (Some(n), Some(dof)) => format!(", {n} pts {dof}"),
+        (Some(n), None) => format!(", {n} pts"),
+        _ => String::new(),
+    };
+    format!("{}, {} links{graded}, {}{flex}", style::timestep(r.timestep_s), r.segments, r.cone)
 }
 
 impl SpeedAccuracy {
