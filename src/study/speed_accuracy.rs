@@ -12,7 +12,7 @@
 //! share the machine without changing each other's speed.
 
 use super::convergence::{FlexSetting, force_rmse};
-use super::{cell, run_all, set, write_csv};
+use super::{Damage, cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
 use tendril_plot::speed_accuracy::{SpeedAccuracyRow, render};
 use tendril_twin::physics::{Dof, FingerConfig, PhysicsConfig};
@@ -88,24 +88,23 @@ impl Grid {
 
     /// Every point, the reference first.
     fn points(&self) -> Vec<Point> {
-        let grid = self;
-        let mut labels = vec![Point::mujoco(grid.reference.0, "implicitfast", "elliptic", grid.reference.1)];
-        for &dt in &grid.timesteps_s {
-            for &segments in &grid.segments {
-                for &integrator in &grid.integrators {
-                    for &cone in &grid.cones {
+        let mut labels = vec![Point::mujoco(self.reference.0, "implicitfast", "elliptic", self.reference.1)];
+        for &dt in &self.timesteps_s {
+            for &segments in &self.segments {
+                for &integrator in &self.integrators {
+                    for &cone in &self.cones {
                         labels.push(Point::mujoco(dt, integrator, cone, segments));
                     }
                 }
-                for &solver in &grid.solvers {
+                for &solver in &self.solvers {
                     labels.push(Point { solver, ..Point::mujoco(dt, "implicitfast", "elliptic", segments) });
                 }
-                if grid.rapier_timesteps_s.contains(&dt) && grid.rapier_segments.contains(&segments) {
-                    labels.extend(grid.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
+                if self.rapier_timesteps_s.contains(&dt) && self.rapier_segments.contains(&segments) {
+                    labels.extend(self.rapier_iterations.iter().map(|&it| Point::rapier(dt, it, segments)));
                 }
             }
             labels.extend(
-                grid.graded
+                self.graded
                     .iter()
                     .map(|&(segments, refinement, from_m)| Point::graded(dt, segments, refinement, from_m)),
             );
@@ -314,7 +313,7 @@ fn measure(
                 (Some(a), Some(b)) => Some((a - b).abs()),
                 _ => None,
             };
-            let peak = |r: &super::StudyRun| r.summary.produce.as_ref().map(|p| p.peak_pressure_kpa);
+            let peak = |r: &super::StudyRun| Damage::of(&r.summary).peak_pressure_kpa;
             let pressure_error = match (peak(r), peak(reference)) {
                 (Some(a), Some(b)) if ok && b > 0.0 => Some(100.0 * (a - b).abs() / b),
                 _ => None,

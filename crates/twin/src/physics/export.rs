@@ -26,8 +26,9 @@ pub fn standalone_xml(model: &Arc<SceneModel>) -> Result<String, PhysicsError> {
     let mut xml = model.xml().to_string();
     // A produce item's flex is written where it starts, with its mass and friction, by the
     // scene itself (its frame's `pos`); only a rigid object's body needs the edits.
-    let rigid = model.produce().is_none();
-    if let (Some(obj), Some(p), true) = (&spec.object, model.placement().object, rigid) {
+    if model.produce().is_none()
+        && let (Some(obj), Some(p)) = (&spec.object, model.placement().object)
+    {
         xml = set_attribute(&xml, "<body name=\"object\"", "pos", &nums(&[p.x, p.y, p.z]))?;
         if let Some(yaw) = obj.yaw_deg {
             xml = set_attribute(&xml, "<body name=\"object\"", "quat", &nums(&yaw_quaternion(yaw)))?;
