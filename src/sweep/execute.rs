@@ -264,3 +264,28 @@ impl Runner<'_> {
         Ok(summaries)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A shipped sweep file is what a user runs first: each one expands and every run's scenario,
+    /// with its grid values, loads as `tendril sweep` would check it before running anything.
+    #[test]
+    fn every_shipped_sweep_file_expands_into_runs_that_load() {
+        let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+        let mut checked = 0;
+        for entry in std::fs::read_dir(&scenarios).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if !(name.starts_with("sweep-") && name.ends_with(".toml")) {
+                continue;
+            }
+            let sweep = crate::sweep::load_sweep(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(!sweep.runs.is_empty(), "{name}");
+            check_runs(&sweep).unwrap_or_else(|e| panic!("{name}: {e}"));
+            checked += 1;
+        }
+        assert!(checked >= 4, "found {checked} sweep files in {}", scenarios.display());
+    }
+}
