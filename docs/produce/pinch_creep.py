@@ -5,10 +5,10 @@ exported by `tendril scene`, and squeezes it between two plates of the finger's 
 plate fixed, the right one pushed by a constant force N, so that the plates' friction carries
 `margin` times the item's weight (2 mu N = margin m g). The analytic answer is that the item does
 not move at any margin above 1. MuJoCo's friction is a soft constraint, so it creeps; this prints
-the item's sliding speed (its vertices' mean height, from 2 s to 4 s) at MuJoCo's default-like
-impedance ratio 3 (the cell's `physics.impratio`) and at 30, for the flex and for a rigid ball of
-the first item's size and mass on the cell's 5 ms contacts. The item's mass, size and friction
-are read from its flexcomp.
+the item's sliding speed (its vertices' mean height, from 2 s to 4 s) at the cell's impedance
+ratio 3 (`physics.impratio`; MuJoCo's own default is 1) and at 30, for the flex and for a rigid
+ball of the first item's size and mass on the cell's 5 ms contacts. The item's mass, size and
+friction are read from its flexcomp.
 
     tendril scene scenarios/cherry-tomato.toml --out /tmp/trilinear.xml
     tendril scene scenarios/cherry-tomato.toml --set 'produce.dof="quadratic"' --out /tmp/quadratic.xml
