@@ -170,6 +170,23 @@ fn unbounded_arguments_are_refused_at_once() {
     }
 }
 
+/// A `--set` a study would not apply is refused before anything runs, naming what to do instead:
+/// on a study that sets no keys, and on a key the speed-accuracy grid sets in every run itself.
+#[test]
+fn a_set_a_study_would_ignore_is_refused_by_name() {
+    for (args, says) in [
+        (vec!["chart", "stability", "--set", "finger.segments=7"], "--set applies to `chart convergence`"),
+        (vec!["chart", "speed-accuracy", "--set", "physics.cone=pyramidal"], "--set physics.cone: the speed-accuracy"),
+        (vec!["chart", "speed-accuracy", "--set", "physics.timestep_s=0.003"], "must be one of the study's steps"),
+    ] {
+        let started = Instant::now();
+        let out = tendril(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+        assert!(started.elapsed() < Duration::from_secs(5), "{args:?} took {:?}", started.elapsed());
+    }
+}
+
 /// The gain map's grid and overrides come from the command line: the grid given is the grid run,
 /// and a gain or an override the bounds refuse is named before anything runs.
 #[test]

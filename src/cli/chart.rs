@@ -49,8 +49,9 @@ pub struct ChartArgs {
     /// [default: 0.000625, the "down to at least 0.625 ms"; at most that, at least 1e-5].
     #[arg(long, value_name = "SECONDS")]
     finest_step: Option<f64>,
-    /// Convergence and gain-map: override a scenario value in every run: `--set key.path=value`
-    /// (repeatable).
+    /// Convergence, speed-accuracy and gain-map: override a scenario value in every run: `--set
+    /// key.path=value` (repeatable). Speed-accuracy refuses the keys its grid sets itself; a set
+    /// step or finger moves the default it rings.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<tendril_config::Override>,
     /// Gain map: the Kp values \[(°/s)/N\] [default: 2,5,10,20,50,100,200; with --quick 5,20].
@@ -95,9 +96,16 @@ fn objects_or(given: &[PathBuf]) -> Vec<PathBuf> {
     }
 }
 
+/// The studies that apply `--set` to every run.
+const SET_STUDIES: [&str; 3] = ["convergence", "speed-accuracy", "gain-map"];
+
 pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
     let out = a.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&a.study));
     let first = |default: &str| a.scenario.first().cloned().unwrap_or_else(|| PathBuf::from(default));
+    // Every other study sets its own keys or runs the scenarios as given: a --set would do nothing.
+    if !a.set.is_empty() && !SET_STUDIES.contains(&a.study.as_str()) {
+        anyhow::bail!("--set applies to `chart {}` only, not to `chart {}`", SET_STUDIES.join("`, `"), a.study);
+    }
     let files = match a.study.as_str() {
         "convergence" => {
             let (files, converged) = convergence(&a, &out)?;
@@ -111,13 +119,13 @@ pub fn run(a: ChartArgs) -> anyhow::Result<ExitCode> {
             use study::speed_accuracy::{Grid, ProduceGrid, run, run_produce};
             let scenario = first("scenarios/crimper.toml");
             // A produce item's study varies its flex instead of the integrator and the cone.
-            let loaded: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&scenario, &[])?;
+            let loaded: tendril_run::scenario::PickPlaceScenario = tendril_config::load(&scenario, &a.set)?;
             match study::convergence::FlexSetting::of(&loaded)? {
                 Some(flex) => {
                     let grid = if a.quick { ProduceGrid::quick(flex) } else { ProduceGrid::full(flex) };
-                    run_produce(&scenario, &grid, &out, a.threads)?
+                    run_produce(&scenario, &grid, &a.set, &out, a.threads)?
                 }
-                None => run(&scenario, &if a.quick { Grid::quick() } else { Grid::full() }, &out, a.threads)?,
+                None => run(&scenario, &if a.quick { Grid::quick() } else { Grid::full() }, &a.set, &out, a.threads)?,
             }
         }
         "stability" => {
@@ -261,8 +269,8 @@ fn controllers(a: &ChartArgs, out: &std::path::Path) -> anyhow::Result<Vec<PathB
     if let Some(seed) = a.seeds.iter().enumerate().find(|(i, s)| a.seeds[..*i].contains(s)).map(|(_, s)| s) {
         anyhow::bail!("--seeds: seed {seed} is given twice (each seed is one run per case)");
     }
-    if !a.set.is_empty() || a.backend.is_some() {
-        anyhow::bail!("--set and --backend apply to `chart convergence` only");
+    if a.backend.is_some() {
+        anyhow::bail!("--backend applies to `chart convergence` only");
     }
     let plan = Plan::new(objects_or(&a.scenario), a.quick, &a.seeds);
     let started = std::time::Instant::now();

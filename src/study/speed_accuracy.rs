@@ -14,7 +14,9 @@
 use super::convergence::{FlexSetting, force_rmse};
 use super::{Damage, cell, run_all, set, write_csv};
 use std::path::{Path, PathBuf};
+use tendril_config::Override;
 use tendril_plot::speed_accuracy::{SpeedAccuracyRow, render};
+use tendril_run::scenario::PickPlaceScenario;
 use tendril_twin::physics::{Dof, FingerConfig, PhysicsConfig};
 
 /// The grid of a speed/accuracy study.
@@ -84,6 +86,24 @@ impl Grid {
             graded: vec![(8, 2, 0.0)],
             solvers: vec![],
         }
+    }
+
+    /// This grid with `default`'s finger among its graded ones, so that it runs at every step;
+    /// an error when `default`'s step is not one of the grid's.
+    fn with_default(&self, default: &Point) -> anyhow::Result<Grid> {
+        if !self.timesteps_s.contains(&default.timestep_s) {
+            anyhow::bail!(
+                "--set physics.timestep_s: the default's step ({} s) must be one of the study's steps ({:?} s)",
+                default.timestep_s,
+                self.timesteps_s
+            );
+        }
+        let mut grid = self.clone();
+        let finger = (default.segments, default.base_refinement, default.fine_from_m);
+        if !grid.graded.contains(&finger) {
+            grid.graded.insert(0, finger);
+        }
+        Ok(grid)
     }
 
     /// Every point, the reference first.
@@ -232,10 +252,9 @@ impl Point {
         Point { integrator: "discrete".into(), flex: Some(flex), ..graded }
     }
 
-    /// The project's default settings (`PhysicsConfig` and `FingerConfig` defaults; for a
+    /// The study's default: the scenario's own step and finger as loaded (after `--set`; for a
     /// produce item, with its flex `flex`).
-    fn project_default(flex: Option<FlexSetting>) -> Point {
-        let (p, f) = (PhysicsConfig::default(), FingerConfig::default());
+    fn scenario_default(p: &PhysicsConfig, f: &FingerConfig, flex: Option<FlexSetting>) -> Point {
         match flex {
             Some(flex) => Point::produce(p.timestep_s, f.segments, flex),
             None => Point::graded(p.timestep_s, f.segments, f.base_refinement, f.fine_from_m),
@@ -256,7 +275,7 @@ impl Point {
         }
     }
 
-    fn overrides(&self) -> Vec<tendril_config::Override> {
+    fn overrides(&self) -> Vec<Override> {
         let mut o = vec![
             set("physics.timestep_s", self.timestep_s),
             set("finger.segments", self.segments),
@@ -279,29 +298,76 @@ impl Point {
     }
 }
 
-/// Runs the study on `scenario`, writes `speed_accuracy.csv` and its chart into `out`, the
-/// project's default settings ringed; `threads` runs at once (speed is each run's own CPU time).
-/// Returns the files written.
-pub fn run(scenario: &Path, grid: &Grid, out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
-    measure(scenario, &grid.points(), &Point::project_default(None), out, threads)
+/// The keys a study's grid sets in every run itself: a `--set` of one would change nothing, so it
+/// is refused. The step and the finger's links are not among them: set, they move the ringed
+/// default, as they move the base of the convergence study.
+const GRID_KEYS: [&str; 8] = [
+    "feedback",
+    "physics.backend",
+    "physics.integrator",
+    "physics.cone",
+    "physics.solver",
+    "physics.rapier.solver_iterations",
+    "produce.count",
+    "produce.dof",
+];
+
+/// Loads `scenario` with `sets` (refusing a key the grid sets itself) and returns its default
+/// point: the scenario's own step and finger, ringed in the chart (for a produce item, with the
+/// flex `flex`).
+fn load_default(scenario: &Path, sets: &[Override], flex: Option<FlexSetting>) -> anyhow::Result<Point> {
+    if let Some(o) = sets.iter().find(|o| GRID_KEYS.contains(&o.key.as_str())) {
+        anyhow::bail!(
+            "--set {}: the speed-accuracy study sets this key in every run itself ({}); set the model's other keys",
+            o.key,
+            GRID_KEYS.join(", ")
+        );
+    }
+    let loaded: PickPlaceScenario = tendril_config::load(scenario, sets)?;
+    Ok(Point::scenario_default(&loaded.physics, &loaded.finger, flex))
 }
 
-/// Runs a produce item's study ([`ProduceGrid`]) on `scenario` and writes the same files, with
-/// the flex's columns and the peak pressure's error.
-pub fn run_produce(scenario: &Path, grid: &ProduceGrid, out: &Path, threads: usize) -> anyhow::Result<Vec<PathBuf>> {
-    measure(scenario, &grid.points(), &Point::project_default(Some(grid.default_flex)), out, threads)
+/// Runs the study on `scenario` with `sets` in every run (the model's keys: a calibration, a
+/// joint, the contacts; the grid's own axes win), writes `speed_accuracy.csv` and its chart into
+/// `out`, the scenario's own step and finger ringed as the default (and run at every step, when
+/// `sets` moves it off the grid's graded fingers); `threads` runs at once (speed is each run's
+/// own CPU time). Returns the files written.
+pub fn run(
+    scenario: &Path,
+    grid: &Grid,
+    sets: &[Override],
+    out: &Path,
+    threads: usize,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let default = load_default(scenario, sets, None)?;
+    measure(scenario, &grid.with_default(&default)?.points(), sets, &default, out, threads)
 }
 
-/// Runs `labels` (the reference first) on `scenario`, `threads` at once, and writes
-/// `speed_accuracy.csv` and its chart into `out`, `default` ringed.
+/// Runs a produce item's study ([`ProduceGrid`]) on `scenario` with `sets` in every run and
+/// writes the same files, with the flex's columns and the peak pressure's error.
+pub fn run_produce(
+    scenario: &Path,
+    grid: &ProduceGrid,
+    sets: &[Override],
+    out: &Path,
+    threads: usize,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let default = load_default(scenario, sets, Some(grid.default_flex))?;
+    measure(scenario, &grid.points(), sets, &default, out, threads)
+}
+
+/// Runs `labels` (the reference first) on `scenario`, each after `sets`, `threads` at once, and
+/// writes `speed_accuracy.csv` and its chart into `out`, `default` ringed.
 fn measure(
     scenario: &Path,
     labels: &[Point],
+    sets: &[Override],
     default: &Point,
     out: &Path,
     threads: usize,
 ) -> anyhow::Result<Vec<PathBuf>> {
-    let runs = run_all(scenario, labels.iter().map(Point::overrides).collect(), threads)?;
+    let overrides = labels.iter().map(|p| sets.iter().cloned().chain(p.overrides()).collect()).collect();
+    let runs = run_all(scenario, overrides, threads)?;
     let reference = &runs[0];
     let rows: Vec<SpeedAccuracyRow> = runs
         .iter()
@@ -401,13 +467,33 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_set_finger_is_ringed_and_run_at_every_step_and_a_grid_key_is_refused() {
+        let crimper = Path::new("scenarios/crimper.toml");
+        let sets = ["finger.segments=7", r#"finger.base_joint="half_link""#].map(|s| s.parse().unwrap());
+        let default = load_default(crimper, &sets, None).unwrap();
+        assert_eq!(default, Point::graded(0.0025, 7, 8, 0.0));
+        let points = Grid::full().with_default(&default).unwrap().points();
+        for dt in Grid::full().timesteps_s {
+            assert_eq!(points.iter().filter(|p| **p == Point::graded(dt, 7, 8, 0.0)).count(), 1, "{dt}");
+        }
+        // The project's own default is already among the graded fingers: the grid is unchanged.
+        let own = load_default(crimper, &[], None).unwrap();
+        assert_eq!(Grid::full().with_default(&own).unwrap().points(), Grid::full().points());
+        let err = load_default(crimper, &[r#"physics.integrator="euler""#.parse().unwrap()], None).unwrap_err();
+        assert!(err.to_string().contains("--set physics.integrator: the speed-accuracy study sets this key"), "{err}");
+        let off_grid = load_default(crimper, &["physics.timestep_s=0.003".parse().unwrap()], None).unwrap();
+        let err = Grid::full().with_default(&off_grid).unwrap_err();
+        assert!(err.to_string().contains("must be one of the study's steps"), "{err}");
+    }
+
+    #[test]
     fn a_produce_grid_holds_its_default_once_and_runs_every_point_on_the_discrete_integrator() {
         let flex = FlexSetting { count: 7, dof: Dof::Trilinear };
         let points = ProduceGrid::full(flex).points();
         // 2 steps × 2 links × 5 flexes, the CG solver at each step, and the reference.
         assert_eq!(points.len(), 23);
         assert_eq!(points[0], Point::produce(0.000625, 16, FlexSetting { count: 13, dof: Dof::Quadratic }));
-        let default = Point::project_default(Some(flex));
+        let default = Point::scenario_default(&PhysicsConfig::default(), &FingerConfig::default(), Some(flex));
         assert_eq!(points.iter().filter(|p| **p == default).count(), 1);
         for p in &points {
             let o = p.overrides();
