@@ -88,6 +88,17 @@ impl Grid {
         }
     }
 
+    /// The grid to run with `sets`: this one, and `default`'s finger among its graded ones when
+    /// `sets` moves it ([`DEFAULT_KEYS`]), so that it runs at every step. The full grid runs the
+    /// project's default finger already; the quick one, a small look, does not.
+    fn for_sets(&self, sets: &[Override], default: &Point) -> anyhow::Result<Grid> {
+        if sets.iter().any(|o| DEFAULT_KEYS.contains(&o.key.as_str())) {
+            self.with_default(default)
+        } else {
+            Ok(self.clone())
+        }
+    }
+
     /// This grid with `default`'s finger among its graded ones, so that it runs at every step;
     /// an error when `default`'s step is not one of the grid's.
     fn with_default(&self, default: &Point) -> anyhow::Result<Grid> {
@@ -312,6 +323,10 @@ const GRID_KEYS: [&str; 8] = [
     "produce.dof",
 ];
 
+/// The keys that move the ringed default: set, its finger runs at every step of the grid.
+const DEFAULT_KEYS: [&str; 4] =
+    ["physics.timestep_s", "finger.segments", "finger.base_refinement", "finger.fine_from_m"];
+
 /// Loads `scenario` with `sets` (refusing a key the grid sets itself) and returns its default
 /// point: the scenario's own step and finger, ringed in the chart (for a produce item, with the
 /// flex `flex`).
@@ -329,9 +344,9 @@ fn load_default(scenario: &Path, sets: &[Override], flex: Option<FlexSetting>) -
 
 /// Runs the study on `scenario` with `sets` in every run (the model's keys: a calibration, a
 /// joint, the contacts; the grid's own axes win), writes `speed_accuracy.csv` and its chart into
-/// `out`, the scenario's own step and finger ringed as the default (and run at every step, when
-/// `sets` moves it off the grid's graded fingers); `threads` runs at once (speed is each run's
-/// own CPU time). Returns the files written.
+/// `out`, the scenario's own step and finger ringed as the default (run at every step when `sets`
+/// moves it, `DEFAULT_KEYS`); `threads` runs at once (speed is each run's own CPU time). Returns
+/// the files written.
 pub fn run(
     scenario: &Path,
     grid: &Grid,
@@ -340,7 +355,7 @@ pub fn run(
     threads: usize,
 ) -> anyhow::Result<Vec<PathBuf>> {
     let default = load_default(scenario, sets, None)?;
-    measure(scenario, &grid.with_default(&default)?.points(), sets, &default, out, threads)
+    measure(scenario, &grid.for_sets(sets, &default)?.points(), sets, &default, out, threads)
 }
 
 /// Runs a produce item's study ([`ProduceGrid`]) on `scenario` with `sets` in every run and
@@ -472,18 +487,21 @@ mod tests {
         let sets = ["finger.segments=7", r#"finger.base_joint="half_link""#].map(|s| s.parse().unwrap());
         let default = load_default(crimper, &sets, None).unwrap();
         assert_eq!(default, Point::graded(0.0025, 7, 8, 0.0));
-        let points = Grid::full().with_default(&default).unwrap().points();
+        let points = Grid::full().for_sets(&sets, &default).unwrap().points();
         for dt in Grid::full().timesteps_s {
             assert_eq!(points.iter().filter(|p| **p == Point::graded(dt, 7, 8, 0.0)).count(), 1, "{dt}");
         }
         // The project's own default is already among the graded fingers: the grid is unchanged.
         let own = load_default(crimper, &[], None).unwrap();
-        assert_eq!(Grid::full().with_default(&own).unwrap().points(), Grid::full().points());
+        assert_eq!(Grid::full().for_sets(&[], &own).unwrap().points(), Grid::full().points());
         let err = load_default(crimper, &[r#"physics.integrator="euler""#.parse().unwrap()], None).unwrap_err();
         assert!(err.to_string().contains("--set physics.integrator: the speed-accuracy study sets this key"), "{err}");
-        let off_grid = load_default(crimper, &["physics.timestep_s=0.003".parse().unwrap()], None).unwrap();
-        let err = Grid::full().with_default(&off_grid).unwrap_err();
+        let off_step = ["physics.timestep_s=0.003".parse().unwrap()];
+        let off_grid = load_default(crimper, &off_step, None).unwrap();
+        let err = Grid::full().for_sets(&off_step, &off_grid).unwrap_err();
         assert!(err.to_string().contains("must be one of the study's steps"), "{err}");
+        // The quick grid, whose steps are not the default's, runs as it is when nothing moves it.
+        assert_eq!(Grid::quick().for_sets(&[], &own).unwrap().points(), Grid::quick().points());
     }
 
     #[test]
