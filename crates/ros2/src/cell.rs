@@ -87,6 +87,10 @@ pub struct Ros2Cell {
     latest: Latest,
     /// Wall clock at activation (or at configure, before it).
     started: Instant,
+    /// The same instant as time since the Unix epoch \[s\]: what the commands' stamps count from.
+    started_epoch_s: f64,
+    /// The cell time of the last read \[s\]: the time a tick's command is for.
+    last_read_s: f64,
     /// `/clock` at activation \[s\] (with `use_sim_time`).
     clock_zero_s: f64,
     /// Each tick's age of the oldest joint and of the peaks [s].
@@ -94,6 +98,11 @@ pub struct Ros2Cell {
     /// Peak messages taken up to the last read.
     peaks_read: u64,
     sample_new: bool,
+}
+
+/// The wall clock as time since the Unix epoch \[s\] (f64 holds it to 0.24 µs).
+fn epoch_s() -> f64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default().as_secs_f64()
 }
 
 fn device(topic: &str, cause: impl Into<String>) -> CellError {
@@ -109,6 +118,8 @@ impl Ros2Cell {
             io: None,
             latest: Latest::default(),
             started: Instant::now(),
+            started_epoch_s: epoch_s(),
+            last_read_s: 0.0,
             clock_zero_s: 0.0,
             ages: [Vec::new(), Vec::new()],
             peaks_read: 0,
@@ -264,15 +275,15 @@ impl Ros2Cell {
         }
     }
 
-    fn command_message(&self, arm_q: [f64; ARM_JOINTS], growth: f64, twine: f64) -> JointState {
-        let stamp = if self.sim_time() {
-            Time::from_secs_f64(self.latest.clock_s.unwrap_or(0.0))
-        } else {
-            let since_epoch = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
-            Time::from_secs_f64(since_epoch.as_secs_f64())
-        };
+    /// The command for cell time `cell_s`, stamped with it on the cell's clock: `/clock` with
+    /// `use_sim_time`, else the wall clock since the epoch. A tick's command is stamped with its
+    /// read's time, not with when it is sent, as the device path stamps its RTDE targets: the
+    /// target is the plan's at that read, and a commander that places targets at their stamps (the
+    /// twin's command clock) then places it there however long the tick waited for the CPU.
+    fn command_message(&self, cell_s: f64, arm_q: [f64; ARM_JOINTS], growth: f64, twine: f64) -> JointState {
+        let zero_s = if self.sim_time() { self.clock_zero_s } else { self.started_epoch_s };
         JointState {
-            header: Header { stamp, frame_id: String::new() },
+            header: Header { stamp: Time::from_secs_f64(zero_s + cell_s), frame_id: String::new() },
             name: self.config.ros2.joints.all().into_iter().map(String::from).collect(),
             position: arm_q.iter().copied().chain([growth, twine]).collect(),
             velocity: Vec::new(),
@@ -348,6 +359,7 @@ impl Cell for Ros2Cell {
         // Re-stamp what was taken before on the new clock: ages count from activation.
         let before = self.now_s();
         self.started = Instant::now();
+        self.started_epoch_s = epoch_s();
         self.clock_zero_s = self.latest.clock_s.unwrap_or(0.0);
         let shift = |s: &mut f64| *s -= before;
         for j in self.latest.joints.iter_mut().flatten() {
@@ -373,7 +385,7 @@ impl Cell for Ros2Cell {
         let q: Vec<Option<f64>> = self.latest.joints.iter().map(|j| j.map(|s| s.value)).collect();
         if let (Some(io), true) = (self.io.as_ref(), q.iter().all(Option::is_some)) {
             let q: Vec<f64> = q.into_iter().flatten().collect();
-            let hold = self.command_message(std::array::from_fn(|j| q[j]), q[6], q[7]);
+            let hold = self.command_message(self.now_s(), std::array::from_fn(|j| q[j]), q[6], q[7]);
             io.commands.publish(&hold).map_err(|e| device(io.commands.topic(), e.to_string()))?;
         }
         Ok(())
@@ -386,6 +398,7 @@ impl Cell for Ros2Cell {
             return Err(e);
         }
         let now = self.now_s();
+        self.last_read_s = now;
         let q: Vec<f64> = self.latest.joints.iter().map(|j| j.map_or(f64::NAN, |s| s.value)).collect();
         let peaks = self.latest.peaks.expect("checked by stale");
         self.sample_new = self.latest.peaks_taken > self.peaks_read;
@@ -409,7 +422,8 @@ impl Cell for Ros2Cell {
 
     fn write(&mut self, command: &CellCommand) -> Result<(), CellError> {
         require_state(self.lifecycle, Lifecycle::Active, "write")?;
-        let m = self.command_message(command.arm_q, command.growth_motor_rad, command.twine_motor_rad);
+        let m =
+            self.command_message(self.last_read_s, command.arm_q, command.growth_motor_rad, command.twine_motor_rad);
         let io = self.io.as_ref().expect("an active cell has its node");
         io.commands.publish(&m).map_err(|e| device(io.commands.topic(), e.to_string()))
     }

@@ -187,8 +187,10 @@ pub fn drive_motors(
 }
 
 impl Ros2Bridge {
-    /// The arm targets of `commands` that arrived at twin time `now_s`, each with the twin time
-    /// it is due and how much later the arm passes it (the command clock, `ros2_clock.rs`), if
+    /// The arm targets of `commands`, taken at twin time `now_s` and wall time `arrived_s` (the
+    /// twin's time had it kept real time: later than `now_s` while the twin runs behind), each
+    /// with the twin time it is due and how much later the arm passes it (the command clock,
+    /// `ros2_clock.rs`), if
     /// the virtual UR5e takes them: not while a URScript program plays (one master at a time, as
     /// on a UR whose external control program owns the arm) or the arm is in a protective stop; a
     /// target beyond the UR5e's range or speed puts it in a protective stop (unlocked on the
@@ -198,6 +200,7 @@ impl Ros2Bridge {
         commands: &[RosCommand],
         s: &mut DeviceState,
         now_s: f64,
+        arrived_s: f64,
         measured_q: [f64; 6],
     ) -> Vec<([f64; 6], f64, f64)> {
         let mut out = Vec::new();
@@ -206,7 +209,7 @@ impl Ros2Bridge {
             if !self.arm_allowed(s, now_s, &q, &measured_q) {
                 return Vec::new();
             }
-            let (due_s, lag_s) = self.arm_clock.place(c.stamp_s, now_s);
+            let (due_s, lag_s) = self.arm_clock.place(c.stamp_s, arrived_s);
             out.push((q, due_s, lag_s));
         }
         out

@@ -9,7 +9,18 @@
 //! smallest delay seen lately (the least delayed command arrived when it was sent), and the arm
 //! passes through it one of the commander's periods later: late commands up to a period behind
 //! still arrive before they are due, and the arm moves at the commander's own cadence.
-
+//!
+//! Two things keep that shift steady:
+//! - Arrivals are timed on the wall clock, not by the twin's ticks. On a loaded machine the twin
+//!   falls behind and catches up (0 to 280 ms behind, over and over, with two busy processes on
+//!   two cores); timed by its ticks, the delays seemed to shrink while it fell behind, the least
+//!   was taken from there, and every target after the catch-up came late and was jumped to (the
+//!   short lift's force read 0.15-2.2 N at its 5th-95th percentiles). Timed on the wall clock it
+//!   read 0.53-0.58 N, as the twin's.
+//! - The shift slews toward the least delay at [`SLEW`], as NTP slews a clock instead of
+//!   stepping it. The least delay changes when the least delayed command leaves the window or a
+//!   less delayed one comes (by 3 ms now and then on an idle machine); applied at once, each
+//!   change moved every later target by as much, and the arm stopped or leapt for it.
 use std::collections::VecDeque;
 
 /// Commands the least delay is taken over \[-\]: 100, a second at 100 Hz, so the clock follows a
@@ -20,6 +31,12 @@ pub const WINDOW: usize = 100;
 /// virtual UR5e's own program cycle) to 50 ms (a 20 Hz commander).
 pub const CADENCE_S: (f64, f64) = (0.002, 0.05);
 
+/// How fast the offset the targets are placed with follows the least delay \[s/s\]: 0.01, a
+/// hundredth of the commander's time, so the arm's speed changes by at most 1 % while it does
+/// (the grip does not feel it). It follows clocks that drift apart by up to 1 %, a hundred times
+/// a quartz clock's 100 ppm, and closes a 10 ms change of the least delay in a second.
+pub const SLEW: f64 = 0.01;
+
 /// Places a commander's stamped targets on the twin's clock.
 #[derive(Debug, Default, Clone)]
 pub struct CommandClock {
@@ -27,6 +44,9 @@ pub struct CommandClock {
     offsets: VecDeque<f64>,
     /// Their stamps \[s\].
     stamps: VecDeque<f64>,
+    /// The offset the targets are placed with \[s\]: the first command's, then slewed toward
+    /// the least of `offsets`.
+    applied: Option<f64>,
 }
 
 impl CommandClock {
@@ -38,7 +58,9 @@ impl CommandClock {
         if !advancing {
             self.offsets.clear();
             self.stamps.clear();
+            self.applied = None;
         }
+        let since_last_s = self.stamps.back().map_or(0.0, |&last| stamp_s - last);
         if self.offsets.len() == WINDOW {
             self.offsets.pop_front();
             self.stamps.pop_front();
@@ -51,7 +73,10 @@ impl CommandClock {
         }
         gaps.sort_by(f64::total_cmp);
         let cadence = gaps[gaps.len() / 2].clamp(CADENCE_S.0, CADENCE_S.1);
-        let offset = self.offsets.iter().copied().fold(f64::INFINITY, f64::min);
+        let least = self.offsets.iter().copied().fold(f64::INFINITY, f64::min);
+        let step = SLEW * since_last_s;
+        let offset = self.applied.map_or(least, |a| a + (least - a).clamp(-step, step));
+        self.applied = Some(offset);
         (stamp_s + offset, cadence)
     }
 }
@@ -78,6 +103,27 @@ mod tests {
             assert!((w[1].1 - 0.01).abs() < 1e-6, "a period of allowance: {w:?}");
         }
         assert!((placed[49].0 - (3.0 + 0.49)).abs() < 1e-6, "on the least delayed command's clock");
+    }
+
+    #[test]
+    fn a_change_of_the_least_delay_is_slewed_not_stepped() {
+        let mut clock = CommandClock::default();
+        // 1 ms late for two windows, then 6 ms late: the least delay rises by 5 ms once the
+        // last 1 ms arrival leaves the window.
+        let placed: Vec<(f64, f64)> = (0..400)
+            .map(|k| {
+                let stamp = k as f64 * 0.01;
+                let late = if k < 200 { 0.001 } else { 0.006 };
+                clock.place(stamp, stamp + late)
+            })
+            .collect();
+        for (k, w) in placed.windows(2).enumerate().skip(1) {
+            let spacing = w[1].0 - w[0].0;
+            assert!((spacing - 0.01).abs() <= SLEW * 0.01 + 1e-9, "target {k}: spacing {spacing}");
+        }
+        // Slewed at 1 %, the 5 ms are closed within 0.5 s of the commander's time.
+        let last = placed[399].0 - 3.99;
+        assert!((last - 0.006).abs() < 1e-9, "on the new least delay at the end: {last}");
     }
 
     #[test]

@@ -156,6 +156,9 @@ pub fn spawn(
             }
             let now_s = (k - 1) as f64 * period_s;
             let ros_commands = ros.as_mut().map(|r| r.take_commands(now_s)).unwrap_or_default();
+            // When they came on the wall clock: a commander's delay is measured on it, not on the
+            // twin's ticks, which run behind it while the twin catches up after a stall.
+            let arrived_s = started.elapsed().as_secs_f64().max(now_s);
             let new_arm_target = {
                 let mut s = lock(&state);
                 // RTDEIOInterface and the like: the IO outputs each input package set.
@@ -181,8 +184,10 @@ pub fn spawn(
                 };
                 // A ROS 2 arm command is a `servoj` target, due at its stamp on the twin's clock: the
                 // setpoint passes it the commander's period and a servo delay later.
-                for (q, due_s, lag_s) in
-                    ros.as_mut().map(|r| r.arm_targets(&ros_commands, &mut s, now_s, measured_q)).unwrap_or_default()
+                for (q, due_s, lag_s) in ros
+                    .as_mut()
+                    .map(|r| r.arm_targets(&ros_commands, &mut s, now_s, arrived_s, measured_q))
+                    .unwrap_or_default()
                 {
                     let last = (command.arm_q, last_step.0);
                     path = Some(ArmPath::servo(path.take(), q, due_s, servo_delay_s + lag_s, last));
