@@ -3,6 +3,11 @@
 //!
 //! Criterion reports the wall time of one run; the bench also prints simulated seconds per wall
 //! second (the goal: ≥ 100× real time on one core).
+//!
+//! `TENDRIL_BENCH_SET` adds scenario overrides to every run (comma-separated `key=value`), so that
+//! another setting is benched in the same sitting as the default, e.g. the whole-link finger:
+//! `TENDRIL_BENCH_SET=finger.base_joint=whole_link,finger.segments=8,physics.contact_timeconst_s=0.005,finger.relaxation_time_s=18
+//! cargo bench --bench scenario -- mujoco`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::path::Path;
@@ -22,6 +27,11 @@ fn scenario(name: &str, backend: Backend, timed: bool) -> PickPlaceScenario {
     }
     if !timed {
         overrides.extend(CHECK_ONLY.map(|s| s.parse().expect("valid")));
+    }
+    if let Ok(extra) = std::env::var("TENDRIL_BENCH_SET") {
+        overrides.extend(
+            extra.split(',').filter(|s| !s.is_empty()).map(|s| s.parse().expect("TENDRIL_BENCH_SET: key=value")),
+        );
     }
     tendril_config::load(&file, &overrides).expect("shipped scenarios load")
 }
@@ -50,12 +60,20 @@ fn full_scenario(c: &mut Criterion) {
             Backend::Rapier => format!("{name}_rapier_32links_5ms"),
         };
         let models = ModelCache::default();
-        if timed {
+        // Only for the benches a filter (`cargo bench --bench scenario -- mujoco`) selects: the
+        // rapier ones take minutes.
+        if timed && selected(&name) {
             print_real_time_factor(&name, &s, &models);
         }
         group.bench_function(&name, |b| b.iter(|| run_on_twin(&s, &models, None).expect("runs")));
     }
     group.finish();
+}
+
+/// Whether criterion's filter (the first argument that is not a flag) selects the bench `name`;
+/// no filter selects every one.
+fn selected(name: &str) -> bool {
+    std::env::args().skip(1).find(|a| !a.starts_with('-')).is_none_or(|filter| name.contains(&filter))
 }
 
 /// Runs `s` twice (the second with the model already compiled), checks both agree and prints the

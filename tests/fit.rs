@@ -11,7 +11,7 @@ const SCENARIO: &str = "scenarios/short-lift.toml";
 
 /// The fit's machinery is under test here, not the physics: the recordings, and so every candidate
 /// (which re-runs a recording's own scenario), use 32 uniform links at a 5 ms step, about twice as
-/// fast as the converged default (2.5 ms, the graded 8-link finger). docs/studies/fit-paper.md#the-hand-calibrations-score,
+/// fast as the converged default (2.5 ms, the graded 28-link finger). docs/studies/fit-paper.md#the-hand-calibrations-score,
 /// scores the default itself.
 const QUICK_NUMERICS: [&str; 6] =
     ["--set", "finger.segments=32", "--set", "finger.base_refinement=1", "--set", "physics.timestep_s=0.005"];

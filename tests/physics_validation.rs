@@ -119,8 +119,8 @@ fn pinch_holds(p: &PhysicsConfig, force: f64, mu: f64, a: f64) -> bool {
     rel0 - rel(&run) < 1e-3
 }
 
-/// Tolerance on the smallest holding force. MuJoCo: 5 % (measured +0.02 % with the default's stiff
-/// 5 ms contacts and no noslip pass). rapier:
+/// Tolerance on the smallest holding force. MuJoCo: 5 % (measured +0.02 % with the whole-link
+/// default's stiff 5 ms contacts and +0.024 % with today's 7.5 ms ones, no noslip pass). rapier:
 /// 5 % too (docs/facts.md#rapier-pinch-holding-force measured about 4 % off at 5 ms; its contacts are solved by impulses per step).
 fn pinch_holding_force_matches_analytic_bound(backend: Backend) {
     let p = physics(backend);

@@ -245,9 +245,13 @@ fn a_harvest_run_says_how_the_fruit_came_off() {
     // The cherry tomato's published detachment force (docs/facts.md#produce-items).
     assert_eq!(p["detach_n"].as_f64(), Some(2.46));
     assert!(p["max_stem_tension_n"].as_f64().unwrap() > 0.1, "the stem carried the fruit: {p}");
-    // A stem that let go did so at its detachment force.
+    // A stem that let go was pulled near its detachment force. It lets go when its elastic
+    // tension reaches 2.46 N; its damping (the plant's resistance to motion) takes off the pull
+    // while the fruit swings back, so the largest pull it passed on may be a little less (the
+    // short harvest, seed 1: 2.41 N on the half-link default, 2 % less; 2.46 N or more before).
+    // The bound allows five times that.
     if !p["detached_s"].is_null() {
-        assert!(p["max_stem_tension_n"].as_f64().unwrap() >= 2.46, "{p}");
+        assert!(p["max_stem_tension_n"].as_f64().unwrap() >= 0.9 * 2.46, "{p}");
     }
     let trace = std::fs::read_to_string(dir.path().join("trace.csv")).unwrap();
     let first = trace.lines().nth(1).unwrap();
@@ -352,7 +356,7 @@ fn the_cherry_tomato_s_default_converges_against_step_over_two() {
     let plan = Plan::for_scenario(&loaded, true, FINEST_TIMESTEP_S).unwrap();
     let settings: Vec<(&str, f64, u32)> =
         plan.settings.iter().map(|s| (s.label.as_str(), s.timestep_s, s.segments)).collect();
-    assert_eq!(settings, [("default", 0.0025, 8), ("step/2", 0.00125, 8)]);
+    assert_eq!(settings, [("default", 0.0025, 7), ("step/2", 0.00125, 7)]);
     let flex = plan.settings[0].flex.expect("a produce item's plan refines its flex");
     assert_eq!((flex.count, flex.dof.name()), (7, "trilinear"), "the shipped grid and degrees of freedom");
     let case = Case { scenario, feedback: false, seed: 1 };
@@ -365,4 +369,32 @@ fn the_cherry_tomato_s_default_converges_against_step_over_two() {
     assert_eq!((result.verdicts.len(), pair.as_str()), (1, "default vs step/2"));
     assert!(verdict.peak_pressure_pct.is_some() && verdict.force_rmse_n.is_some(), "{verdict:?}");
     assert_eq!(verdict.failures(&CRITERIA), Vec::<&str>::new(), "{verdict:?}");
+}
+
+#[test]
+fn the_shipped_basil_bunch_falls_onto_the_table_as_a_drop_not_a_divergence() {
+    // The bunch falls 5 s into the lift (docs/studies/produce.md, finding 3); its soft calibrated
+    // contact lets the fall 40-50 mm into the table, past `physics.max_penetration_m`'s 30 mm, and
+    // it comes to rest 1.5 mm in. The item's own drop depth (`Calibration::drop_depth_m`) bounds
+    // its contacts instead, so the run ends in its drop. With the 30 mm bound it ended in
+    // "physics failed: contact 0.0304 m deep between `table` and `produce (flex)`".
+    let dir = tempfile::tempdir().unwrap();
+    let out = tendril(&["run", "scenarios/basil.toml", "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["outcome"].as_str(), Some("dropped"), "{}", summary["error"]);
+    assert!(summary["error"].is_null(), "{}", summary["error"]);
+}
+
+#[test]
+fn a_soft_item_s_drop_depth_is_its_contact_s_and_a_firm_one_keeps_the_cell_s_bound() {
+    // v / √k at 1.5 m/s: the basil bunch's 150 /s² contact lets a drop 0.12 m in; the cherry
+    // tomato's stiff one less than the cell's 30 mm, so the cell's bound stands for it.
+    let basil = plates::calibrate(&item("basil"), &physics()).unwrap();
+    let depth = basil.drop_depth_m();
+    assert!((depth - plates::DROP_SPEED_M_S / basil.contact_stiffness.sqrt()).abs() < 1e-12);
+    assert!(depth > 0.05 && depth < 0.2, "basil: {depth} m ({} /s²)", basil.contact_stiffness);
+    let tomato = plates::calibrate(&item("cherry_tomato"), &physics()).unwrap();
+    assert!(tomato.drop_depth_m() < PhysicsConfig::default().max_penetration_m, "{}", tomato.drop_depth_m());
 }

@@ -47,7 +47,7 @@ fn a_run_is_reproduced_from_its_own_directory() {
         serde_json::from_str(&std::fs::read_to_string(first.join("summary.json")).unwrap()).unwrap();
     let effective = &summary["effective_scenario"];
     assert_eq!(effective["physics"]["timestep_s"], 0.004, "the --set timestep");
-    assert_eq!(effective["finger"]["segments"], 8, "a default the file does not name");
+    assert_eq!(effective["finger"]["segments"], 7, "a default the file does not name");
     assert_eq!(effective["finger"]["base_refinement"], 8, "a default the file does not name");
     assert_eq!(effective["physics"]["arm_mode"], "dynamic", "MuJoCo's arm, which the file does not name");
     assert_eq!(effective["controller"]["kp"], 25.0);

@@ -1,9 +1,12 @@
-//! The workspace move (one steppable run session behind every run path) changed no answer: the six
-//! Section V runs (crimper, shampoo and hammer, feedback on and off, seed 1) write the same
-//! `trace.csv` bytes and the same `summary.json`, but for its timing fields, as main 67179d3 did
-//! before the move. `tests/fixtures/section_v_67179d3.json` holds, per run, the sha256 of that
-//! commit's trace and its summary without the timing fields, the checkout's own folder (which the
-//! summary's resolved paths name) written as `<checkout>`.
+//! The Section V runs (crimper, shampoo and hammer, feedback on and off, seed 1) write the same
+//! `trace.csv` bytes and the same `summary.json`, but for its timing fields, as the default they
+//! were last written with. `tests/fixtures/section_v_half_link.json` holds, per run, the sha256 of
+//! that default's trace and its summary without the timing fields, the checkout's own folder
+//! (which the summary's resolved paths name) written as `<checkout>`.
+//!
+//! Its history: main 67179d3 wrote it before the workspace move, which changed no answer; the
+//! switch to the half-link default (`finger.base_joint = "half_link"`, 28 links, 7.5 ms contacts,
+//! a 19 s creep; models/README.md, "Calibration to the paper's pick-and-place") rewrote it.
 //!
 //! A change that means to move the twin's answers (a new contact model, a new default) fails here;
 //! its commit rewrites the fixture from the new binary's runs and says why in its message.
@@ -17,7 +20,7 @@ use sha2::{Digest, Sha256};
 const TIMING_FIELDS: [&str; 4] = ["wall_time_s", "real_time_factor", "cpu_time_s", "sim_s_per_cpu_s"];
 
 fn fixture() -> serde_json::Value {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/section_v_67179d3.json");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/section_v_half_link.json");
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
@@ -54,7 +57,7 @@ fn differing_fields(old: &serde_json::Value, new: &serde_json::Value, path: &str
 }
 
 #[test]
-fn section_v_runs_are_unchanged_since_67179d3() {
+fn section_v_runs_are_unchanged_since_the_half_link_default() {
     let expected = fixture();
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
@@ -65,7 +68,7 @@ fn section_v_runs_are_unchanged_since_67179d3() {
             let trace_sha256 = format!("{:x}", Sha256::digest(&trace));
             if trace_sha256 != expected[&name]["trace_sha256"] {
                 failures.push(format!(
-                    "{name}: trace.csv sha256 {trace_sha256}, {} at 67179d3",
+                    "{name}: trace.csv sha256 {trace_sha256}, {} in the fixture",
                     expected[&name]["trace_sha256"]
                 ));
             }

@@ -29,9 +29,11 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }
 
-/// The hammer's trace, seed 1, as main wrote it before the array existed (1823ba7). A change that
-/// moves the default run on purpose records the new fingerprint here and says why.
-const HAMMER_TRACE_FNV1A: u64 = 0x2131_8eae_7fb6_f6d0;
+/// The hammer's trace, seed 1: without an array the run is the single pad's, byte for byte. First
+/// recorded as main wrote it before the array existed (1823ba7); recorded again for the switch to
+/// the half-link default (the same trace as tests/fixtures/section_v_half_link.json's hammer-on).
+/// A change that moves the default run on purpose records the new fingerprint here and says why.
+const HAMMER_TRACE_FNV1A: u64 = 0xdae1_8a6d_3070_b6b5;
 
 #[test]
 fn the_single_pad_run_is_todays_byte_for_byte() {
@@ -165,13 +167,27 @@ fn crimper_with_array(sets: &[&str], out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
-/// The array's slip cue sees the knocked crimper's drop before it happens (seed 1: 0.16 s before,
-/// docs/studies/placement.md), and stays silent through a run that holds.
+/// The whole-link finger the array's cue was set on (`array.cue_transfer`): on it the cue sees the
+/// knocked crimper's drop before it happens (seed 1: 0.16 s before) and stays silent through a run
+/// that holds. On today's half-link default it alarms in the crimper's lift, before the knock, and
+/// once in a held run (docs/studies/placement.md); the cue is not retuned for it yet, so this test
+/// keeps the finger it was set on.
+const WHOLE_LINK_FINGER: [&str; 4] = [
+    "finger.base_joint=\"whole_link\"",
+    "finger.segments=8",
+    "finger.relaxation_time_s=18",
+    "physics.contact_timeconst_s=0.005",
+];
+
 #[test]
 fn the_array_cue_fires_before_a_knocked_drop_and_not_in_a_held_run() {
     let dir = tempfile::tempdir().unwrap();
     let knocked = crimper_with_array(
         &[
+            WHOLE_LINK_FINGER[0],
+            WHOLE_LINK_FINGER[1],
+            WHOLE_LINK_FINGER[2],
+            WHOLE_LINK_FINGER[3],
             "task.minimum_durations=false",
             "disturbance.push.impulse_n_s=0.3",
             "disturbance.push.duration_s=0.02",
@@ -183,7 +199,7 @@ fn the_array_cue_fires_before_a_knocked_drop_and_not_in_a_held_run() {
     assert_eq!(knocked["outcome"], "dropped");
     let delay = knocked["array"]["cue_detection_delay_s"].as_f64().expect("the cue saw the drop");
     assert!(delay < 0.0, "the cue came {delay} s after the drop");
-    let held = crimper_with_array(&[], &dir.path().join("held"));
+    let held = crimper_with_array(&WHOLE_LINK_FINGER, &dir.path().join("held"));
     assert_eq!(held["outcome"], "held");
     assert_eq!(held["array"]["cue_alarms"], 0, "{}", held["array"]);
     assert_eq!(held["array"]["pad_figures"].as_array().unwrap().len(), 3);

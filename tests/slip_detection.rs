@@ -58,8 +58,8 @@ fn a_steady_grip_under_thirty_picometres_of_noise_raises_no_alarm() {
 fn without_feedback_and_without_a_wrist_sensor_the_pad_loses_the_crimper_seconds_before_it_falls() {
     // The object then hangs on the palm's pinch (models/README.md): the sensor's loss is a false
     // alarm by the ground truth, and the drop itself is not seen. On the converged default the pad
-    // lets go 2.2 s before the crimper falls (seed 1: alarm 7.83 s, drop 9.98 s; 4-8 s on the
-    // coarser 32-link finger).
+    // lets go 2.5 s before the crimper falls (seed 1: alarm 7.32 s, drop 9.79 s; 2.2 s on the
+    // whole-link default before it, 4-8 s on the coarser 32-link finger).
     let s = run("crimper", &["feedback=false", "wrist.present=false"]);
     assert_eq!(s.outcome, "dropped");
     let (drop, alarm) = (s.drop_time_s.unwrap(), s.drop_alarm_s.expect("the pad's loss is an alarm"));

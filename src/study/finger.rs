@@ -4,8 +4,9 @@
 //! object, on the twin; and the size the numbers recommend.
 //!
 //! Each growth length is a strip of that length grown out whole (`finger.length_m` =
-//! `task.growth_m`), cut into links of the default finger's 17.5 mm (`finger.segments` in
-//! proportion), so the discretisation is the converged default's at every length. Per case:
+//! `task.growth_m`), cut into links of about the default finger's 20 mm (`finger.segments` in
+//! proportion, rounded: 19.4-21 mm at the study's lengths), so the discretisation is the converged
+//! default's at every length. Per case:
 //! - feedback on (the paper's mode 2): held or not, the largest pad force (estimate) and grip
 //!   force (ground truth, the strip and pad on the object) while holding, the area of the finger's
 //!   faces on the object when the lift starts ([`tendril_twin::physics::Scene::contact_area_m2`]),
@@ -28,8 +29,9 @@ use tendril_run::execute::{ModelCache, summarize};
 use tendril_run::scenario::PickPlaceScenario;
 use tendril_run::session::{Action, Session};
 
-/// The default finger's link length \[m\]: 14 cm in 8 links.
-pub const LINK_M: f64 = 0.0175;
+/// The default finger's link length \[m\]: 14 cm in 7 links (`FingerConfig`'s default; a test
+/// holds the two together).
+pub const LINK_M: f64 = 0.02;
 
 /// Growth lengths of the full study \[m\]: the paper's 14 cm and two links either side.
 pub const GROWTH_M: [f64; 5] = [0.105, 0.1225, 0.14, 0.1575, 0.175];
@@ -476,6 +478,12 @@ pub fn recommend(summary: &[FingerRow]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_studys_links_are_the_default_fingers() {
+        let f = tendril_twin::physics::FingerConfig::default();
+        assert!((LINK_M - f.length_m / f64::from(f.segments)).abs() < 1e-12, "{LINK_M} m against {f:?}");
+    }
 
     fn row(growth_m: f64, peak_grip_mean_n: f64, bruised: usize) -> FingerRow {
         FingerRow {

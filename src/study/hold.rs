@@ -11,8 +11,8 @@ use tendril_plot::panels::{Mark, Panel, Panels, Series};
 use tendril_run::execute::{ModelCache, run_on_twin};
 use tendril_run::scenario::PickPlaceScenario;
 
-/// The shortened hour: a 150 s grasp with the strip's relaxation time 3 s instead of 18 (the
-/// standard linear solid's retardation time 60 s instead of 360), so the travel runs out within the
+/// The shortened hour: a 150 s grasp with the strip's relaxation time 3 s instead of 19 (the
+/// standard linear solid's retardation time 60 s instead of 380), so the travel runs out within the
 /// grasp when the grip is held at the setpoint.
 pub fn fast_creep() -> Vec<Override> {
     vec![set("task.grasp_s", 150), set("finger.relaxation_time_s", 3.0)]

@@ -51,11 +51,12 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// The full study (about 130 runs): uniform fingers around the 64 links the uniform grid
-    /// converges at, halved and doubled, and graded fingers (the default, 8 links with a base
-    /// stretch 8x finer, among them), each at a step of 0.625-5 ms, against the convergence
-    /// study's finest setting.
+    /// The full study (about 140 runs): uniform fingers around the 64 links the uniform grid
+    /// converges at, halved and doubled, and graded fingers (the default's first, 7 links with a
+    /// base stretch 8x finer), each at a step of 0.625-5 ms, against the convergence study's
+    /// finest setting.
     pub fn full() -> Grid {
+        let f = FingerConfig::default();
         Grid {
             timesteps_s: vec![0.000625, 0.00125, 0.0025, 0.005],
             integrators: vec!["euler", "implicitfast", "implicit", "rk4"],
@@ -65,9 +66,18 @@ impl Grid {
             rapier_timesteps_s: vec![0.0025, 0.005],
             rapier_segments: vec![32],
             reference: (0.0003125, 256),
-            // The last: the default with its first 17.5 mm as one coarse link (issue 39's lever 2,
-            // fine links only where objects touch; docs/studies/levers.md).
-            graded: vec![(8, 8, 0.0), (16, 8, 0.0), (16, 4, 0.0), (32, 2, 0.0), (8, 8, 0.0175)],
+            // The default's finger, then the whole-link default's links (8 with the base 8x finer),
+            // finer and graded otherwise, and last those 8 links with their first 17.5 mm as one
+            // coarse link (issue 39's lever 2, fine links only where objects touch;
+            // docs/studies/levers.md).
+            graded: vec![
+                (f.segments, f.base_refinement, f.fine_from_m),
+                (8, 8, 0.0),
+                (16, 8, 0.0),
+                (16, 4, 0.0),
+                (32, 2, 0.0),
+                (8, 8, 0.0175),
+            ],
             solvers: vec!["cg"],
         }
     }
@@ -168,33 +178,35 @@ pub struct ProduceGrid {
 
 impl ProduceGrid {
     /// The full study around the item's flex `flex` (23 runs for a trilinear flex of 7 points):
-    /// the step at 2.5 and 1.25 ms, 8 and 16 links, the grid coarser (5 points), as given and
-    /// refined (twice the intervals), trilinear and quadratic, and the CG solver, against the
-    /// refined quadratic flex at 0.625 ms and 16 links.
+    /// the step at 2.5 and 1.25 ms, the default's links and twice them, the grid coarser (5
+    /// points), as given and refined (twice the intervals), trilinear and quadratic, and the CG
+    /// solver, against the refined quadratic flex at 0.625 ms and twice the default's links.
     pub fn full(flex: FlexSetting) -> ProduceGrid {
+        let links = FingerConfig::default().segments;
         let (coarse, fine) = (flex.count.saturating_sub(2).max(3), 2 * flex.count - 1);
         let at = |count: u32, dof: Dof| FlexSetting { count, dof };
         let mut flexes = vec![at(coarse, Dof::Trilinear), at(flex.count, Dof::Trilinear), at(fine, Dof::Trilinear)];
         flexes.extend([at(flex.count, Dof::Quadratic), at(fine, Dof::Quadratic)]);
         ProduceGrid {
             timesteps_s: vec![0.0025, 0.00125],
-            segments: vec![8, 16],
+            segments: vec![links, 2 * links],
             flexes,
             solvers: vec!["cg"],
-            reference: (0.000625, 16, at(fine, Dof::Quadratic)),
+            reference: (0.000625, 2 * links, at(fine, Dof::Quadratic)),
             default_flex: flex,
         }
     }
 
-    /// A small grid for a quick look: the item's flex and its quadratic form at 2.5 ms and 8
-    /// links, against the same flex at 1.25 ms.
+    /// A small grid for a quick look: the item's flex and its quadratic form at 2.5 ms and the
+    /// default's links, against the same flex at 1.25 ms.
     pub fn quick(flex: FlexSetting) -> ProduceGrid {
+        let links = FingerConfig::default().segments;
         ProduceGrid {
             timesteps_s: vec![0.0025],
-            segments: vec![8],
+            segments: vec![links],
             flexes: vec![flex, FlexSetting { dof: Dof::Quadratic, ..flex }],
             solvers: vec![],
-            reference: (0.00125, 8, flex),
+            reference: (0.00125, links, flex),
             default_flex: flex,
         }
     }
@@ -484,12 +496,12 @@ mod tests {
     #[test]
     fn a_set_finger_is_ringed_and_run_at_every_step_and_a_grid_key_is_refused() {
         let crimper = Path::new("scenarios/crimper.toml");
-        let sets = ["finger.segments=7", r#"finger.base_joint="half_link""#].map(|s| s.parse().unwrap());
+        let sets = ["finger.segments=6", r#"finger.base_joint="whole_link""#].map(|s| s.parse().unwrap());
         let default = load_default(crimper, &sets, None).unwrap();
-        assert_eq!(default, Point::graded(0.0025, 7, 8, 0.0));
+        assert_eq!(default, Point::graded(0.0025, 6, 8, 0.0));
         let points = Grid::full().for_sets(&sets, &default).unwrap().points();
         for dt in Grid::full().timesteps_s {
-            assert_eq!(points.iter().filter(|p| **p == Point::graded(dt, 7, 8, 0.0)).count(), 1, "{dt}");
+            assert_eq!(points.iter().filter(|p| **p == Point::graded(dt, 6, 8, 0.0)).count(), 1, "{dt}");
         }
         // The project's own default is already among the graded fingers: the grid is unchanged.
         let own = load_default(crimper, &[], None).unwrap();
@@ -510,7 +522,8 @@ mod tests {
         let points = ProduceGrid::full(flex).points();
         // 2 steps × 2 links × 5 flexes, the CG solver at each step, and the reference.
         assert_eq!(points.len(), 23);
-        assert_eq!(points[0], Point::produce(0.000625, 16, FlexSetting { count: 13, dof: Dof::Quadratic }));
+        let links = FingerConfig::default().segments;
+        assert_eq!(points[0], Point::produce(0.000625, 2 * links, FlexSetting { count: 13, dof: Dof::Quadratic }));
         let default = Point::scenario_default(&PhysicsConfig::default(), &FingerConfig::default(), Some(flex));
         assert_eq!(points.iter().filter(|p| **p == default).count(), 1);
         for p in &points {

@@ -4,20 +4,21 @@
 //!
 //! Why: the strip's tendon path creeps as a standard linear solid (models/README.md, "How the
 //! grasp works"). Under a held tension T the path stretches towards T / (f K), twenty times its
-//! elastic stretch with the calibrated f = 0.05, with the retardation time τ / f = 360 s; a force
+//! elastic stretch with the calibrated f = 0.05, with the retardation time τ / f = 380 s; a force
 //! loop holding the setpoint winds that stretch in, and after about five minutes the motor reaches
 //! the end of its travel (docs/cell/timing.md, "The hour on an idle machine").
 //!
 //! Which recovery the mechanism allows:
 //! - **Release and re-wrap** (this module). The creep grows only while the path carries tension,
 //!   and is not given back when the tendon goes slack (the twin's dashpot has nothing to pull it
-//!   back; a real standard linear solid recovers with the same 360 s), so a release gains no
+//!   back; a real standard linear solid recovers with the same 380 s), so a release gains no
 //!   travel, but it stops the creep from growing: one re-wrap needs the grip's own twine plus the
 //!   creep of the grasp before the release. Released early (after 30 s), the hour costs the travel
 //!   of a 30 s grasp. The object waits standing on the table, where it stood before the grasp.
 //! - **A light grip instead of a release** does not stop the creep: the pad is loaded only once the
 //!   wrap is tight, so a quarter of the setpoint on the pad keeps about two thirds of the wrap's
-//!   force and of the tendon's tension (measured on the crimper: the pad's 0.62 N cut to 0.16 N,
+//!   force and of the tendon's tension (measured on the crimper, on the whole-link default with its
+//!   360 s: the pad's 0.62 N cut to 0.16 N,
 //!   the grip's 3.65 N only to 2.45 N), and the travel still ran out in the hour (at 442 s instead
 //!   of 304 s).
 //! - **A growth step** cannot tighten the wrap: the tendon runs along the strip, so feeding strip
@@ -43,7 +44,7 @@ pub struct HoldConfig {
     pub enabled: bool,
     /// A grasp lets go once it has lasted this long \[s\] (and enough of it is left for a re-wrap,
     /// `rewrap_settle_s`). 30 s: twice the paper's 15 s grasp, so the paper's task never lets go, and a twelfth
-    /// of the creep's 360 s retardation time, so the re-wrap needs little more travel than the
+    /// of the creep's 380 s retardation time, so the re-wrap needs little more travel than the
     /// first wrap.
     pub release_after_s: f64,
     /// ... or once the twine motor has turned this fraction of its travel
@@ -56,7 +57,8 @@ pub struct HoldConfig {
     /// the re-wrap starts this long plus its guarded close before the move. The close winds at
     /// `task.wrap_speed_deg_s` to first contact, which comes near the twine the grasp let go at (the
     /// creep is not given back), so it is timed as that twine over the close's speed (4 s after an
-    /// hour's grasp on the crimper, 10 s when the strip creeps six times faster). 5 s: the paper's
+    /// hour's grasp on the crimper, 10 s when the strip creeps six times faster, on the whole-link
+    /// default). 5 s: the paper's
     /// 90 % of the setpoint within 5 s.
     pub rewrap_settle_s: f64,
 }

@@ -26,8 +26,8 @@ pub struct SettleConfig {
     /// 15 %: from `tendril chart settle` (docs/studies/cycle.md), the only band studied (5, 10,
     /// 15 %) that every object met within the timeout on every seed: the crimper's and the
     /// shampoo's estimates sit several per cent under their setpoints (the integral's ramp error
-    /// against the creep), so ±5 % settled neither, and ±10 % settled the crimper in 15 runs of
-    /// 30 over dwells of 0.5-2 s (seeds 1-10).
+    /// against the creep), so ±5 % settled neither, and ±10 % settled the crimper in 20 runs of
+    /// 30 over dwells of 0.5-2 s (seeds 1-10; 15 on the whole-link default before).
     pub band_pct: f64,
     /// How long the estimate must stay in the band \[s\]. 0.5 s: from the same study, the
     /// shortest cycle among the dwells (0.5, 1, 2 s) that held every object on every seed; each

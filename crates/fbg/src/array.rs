@@ -115,8 +115,10 @@ pub struct ArrayConfig {
     pub guard_nm: f64,
     /// The array's slip cue (`tendril_control::array_cue`): an alarm when this fraction of the
     /// pads' load has moved from pad to pad against its slow average [-]. 0.3, a stated choice
-    /// (about a third of the load moved): with it the cue stays silent in every held run of the
-    /// placement study and sees the knocked crimpers' drops (docs/studies/placement.md).
+    /// (about a third of the load moved): with it, on the whole-link default it was set on, the
+    /// cue stayed silent in every held run of the placement study and saw the knocked crimpers'
+    /// drops; on today's half-link default it alarms in some held runs and early in the knocked
+    /// crimpers' lifts, before their knocks (docs/studies/placement.md). Not retuned yet.
     pub cue_transfer: f64,
     /// Time constant of the shares' slow average \[s\]: 1 s, the time the lift takes to bring the
     /// object's weight on (its acceleration ramp), so that drift is followed and a knock is not.

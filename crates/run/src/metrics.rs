@@ -102,9 +102,10 @@ pub const PUSH_IMPACT_S: f64 = 1.0;
 
 /// Height above its resting place on the table below which an object counts as set down \[m\]
 /// (2 mm: resting, or touching down within a tick at the lowering's speed). A knocked object
-/// slides down the grip (the hammer by 18 mm) and the lowering, planned for the object where it
-/// was, then sets it on the table early: the table pushes it into the pad (the hammer's estimate
-/// 4.6 N on a 1.6 N setpoint, 190 %). That reading is the table's, not the grip's.
+/// slides down the grip (the hammer by 15-18 mm where it is held) and the lowering, planned for
+/// the object where it was, then sets it on the table early: the table pushes it into the pad
+/// (the hammer's estimate 4.6 N on a 1.6 N setpoint, 190 %, on the whole-link default). That
+/// reading is the table's, not the grip's.
 pub const SET_DOWN_HEIGHT_M: f64 = 0.002;
 
 /// Largest |F − setpoint| / setpoint \[%\] over the ticks the arm moves and `counts` accepts;

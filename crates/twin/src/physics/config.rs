@@ -219,7 +219,8 @@ impl ArmMode {
 /// a small tolerance (MuJoCo's advice for slip accuracy; docs/facts.md#mujoco-pyramidal-cones-creep measured that pyramidal cones
 /// creep), stiff contacts that hold objects without noslip iterations, and the largest step at which
 /// the Section V answers agree with half that step and the contacts keep their time constant. About
-/// 30x real time on one core with the default graded finger (benches/scenario.rs; docs/studies/speed-accuracy.md#the-figures).
+/// 30× real time on one core with the default graded finger (26-34× over three rounds of
+/// benches/scenario.rs in one sitting; docs/studies/speed-accuracy.md#the-figures).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
@@ -273,12 +274,16 @@ pub struct PhysicsConfig {
     pub noslip_iterations: u32,
     /// No-slip solver tolerance.
     pub noslip_tolerance: f64,
-    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 5 ms: stiff enough
-    /// that soft-contact creep does not let a held object slide without noslip (the slope and pinch
-    /// tests in tests/physics_validation.rs pass with noslip off), and two steps at the 2.5 ms
-    /// default, MuJoCo's least (a shorter one is stretched to two steps). A numerical stiffness of
-    /// the soft-contact model, not a material property: at 1.25 and 0.625 ms (four and eight steps)
-    /// the Section V answers are the default's.
+    /// Contact solref time constant \[s\] (global default): stiffness of contacts. 7.5 ms: stiff
+    /// enough that soft-contact creep does not let a held object slide without noslip (the slope
+    /// and pinch tests in tests/physics_validation.rs pass with noslip off), and three steps at the
+    /// 2.5 ms default. With the half-link clamp (`finger.base_joint`) two steps (5 ms, MuJoCo's
+    /// least: a shorter one is stretched to two) let the pinch's contact ring for one sample as
+    /// the crimper's weight comes on (its fluctuation with feedback 12.4-20.1 % over seeds 1-10,
+    /// against 12.6-14.9 % at a 1.25 ms step); three give 13.1-14.4 % and move no drop without
+    /// feedback by more than 0.17 s (models/README.md). A numerical stiffness of the soft-contact
+    /// model, not a material property: at 1.25 and 0.625 ms (six and twelve steps) the Section V
+    /// answers are the default's.
     pub contact_timeconst_s: f64,
     /// Contact solref damping ratio (1 = critical).
     pub contact_dampratio: f64,
@@ -296,7 +301,8 @@ pub struct PhysicsConfig {
     /// through the finger or onto the table at up to ~1.5 m/s (a 12 cm fall), and soft contacts let it
     /// in by about v × their time constant before pushing it out (30 mm with 20 ms contacts; a 5 mm
     /// bound turned such drops into "physics failed" errors). A blown-up simulation still goes far
-    /// past 30 mm.
+    /// past 30 mm. A produce item's contacts may go deeper where its calibrated contact lets a
+    /// 1.5 m/s drop in further (`v / √stiffness`: the basil bunch 0.12 m, docs/studies/produce.md).
     pub max_penetration_m: f64,
     /// Divergence bound: largest allowed kinetic energy of the scene \[J\]. The cell's moving parts hold
     /// < 5 J at UR5e speeds (20 kg arm at 0.5 m/s); 200 J means runaway.
@@ -327,7 +333,7 @@ impl Default for PhysicsConfig {
             ls_iterations: 20,
             noslip_iterations: 0,
             noslip_tolerance: 1e-8,
-            contact_timeconst_s: 0.005,
+            contact_timeconst_s: 0.0075,
             contact_dampratio: 1.0,
             contact_solimp: [0.95, 0.99, 0.001],
             arm_mode: Backend::Mujoco.default_arm_mode(),
@@ -398,21 +404,25 @@ pub enum BaseJoint {
 #[serde(deny_unknown_fields, default)]
 pub struct FingerConfig {
     /// Number of strip segments (discretisation; the pad's casing and the tip's anchor are single
-    /// rigid pieces at any number, `strip::layout`). 8, with `base_refinement` 8: 17.5 mm links
-    /// from the pad to the tip and 2.2 mm links from the strip's base to the pad, 30 bodies in all.
-    /// Its answers agree with 16 and 32 links and with a quarter of the step by the convergence
-    /// criteria in 89 of 90 comparisons, and with the uniform 64-link finger's drop times within
-    /// 0.2 s, at 2.5 times its speed (docs/studies/convergence.md#the-uniform-64-link-finger; `docs/convergence/`). An object much
-    /// smaller than the paper's (a wrap of under ~4 links per turn) should be checked at links x2
-    /// (`tendril chart convergence --quick`). A numerical choice, not a calibration knob.
+    /// rigid pieces at any number, `strip::layout`). 7, with `base_refinement` 8: 20 mm links
+    /// from the pad to the tip and 2.5 mm links from the strip's base to the pad, 28 bodies in all.
+    /// With the clamp at half a link (`base_joint`) its answers agree with links x2 and with a
+    /// quarter of the step by every one of the 90 convergence criteria, against the 0.625 ms
+    /// reference and against the 0.156 ms one; 21 and 24 links broke 2 and 5 of them
+    /// (models/README.md, "Where the pinch's first order came from"; `docs/convergence/`). An
+    /// object much smaller than the paper's (a wrap of under ~4 links per turn) should be checked
+    /// at links x2 (`tendril chart convergence --quick`). A numerical choice, not a calibration
+    /// knob.
     pub segments: u32,
     /// How many times finer than `segments` implies the links are between the strip's base and the
     /// pad's casing (1: a uniform grid). A numerical choice, like `segments`: that stretch holds the
     /// pinch between palm and strip where the wrap starts, which carries most of an object held
     /// without feedback and converges only at first order in the link length there with the
-    /// default clamp (`base_joint`; models/README.md, "What still moves with the links"), so it
-    /// gets the 2.2 mm links the uniform finger needed there, while the distal stretch, whose
-    /// loads change slowly, keeps coarse ones. Doubling `segments` halves both grids.
+    /// whole-link clamp (`base_joint`; models/README.md, "What still moves with the links"), so it
+    /// got the 2.2 mm links the uniform finger needed there; with the half-link clamp it still
+    /// needs them (2.5 mm at the default), because the strip's first 20 mm bends by about 30 rad/m
+    /// (`fine_from_m`), while the distal stretch, whose loads change slowly, keeps coarse ones.
+    /// Doubling `segments` halves both grids.
     pub base_refinement: u32,
     /// Arc length from the strip's base where the fine grid of `base_refinement` starts \[m\]; the
     /// strip below it keeps the coarse links of `segments`. 0 (the default): the fine grid runs
@@ -423,16 +433,14 @@ pub struct FingerConfig {
     /// `tendril chart convergence --quick --set finger.fine_from_m=...`.
     pub fine_from_m: f64,
     /// How much strip the joint at the strip's base (the guide's exit, where the grown strip is
-    /// clamped) stands for: `"whole_link"` (the default: the whole first link, so that joint is
-    /// half as stiff as the next ones for the same length) or `"half_link"` (the Hencky bar-chain's
-    /// clamp: the half of the first link beside it, so it gets `2 EI / l`). A numerical choice of
-    /// the discretisation. `"whole_link"` adds a compliance of half a link at the clamp, an error of
-    /// first order in the base links' length, and that is the pinch's first-order error. With
-    /// `"half_link"` links ×2 moves the three drops without feedback by 0.01-0.08 s (seeds 1-3),
-    /// with `"whole_link"` by 0.27-0.41 s (the crimper's 10.14 s to 9.82 s; models/README.md,
-    /// "Where the pinch's first order came from"). The default stays `"whole_link"` until the
-    /// creep's calibration and the book's studies are redone on `"half_link"`, which moves the
-    /// default's drops 0.5-1.1 s earlier.
+    /// clamped) stands for: `"half_link"` (the default: the Hencky bar-chain's clamp, the half of
+    /// the first link beside it, so it gets `2 EI / l`) or `"whole_link"` (the default before: the
+    /// whole first link, so that joint is half as stiff as the next ones for the same length). A
+    /// numerical choice of the discretisation. `"whole_link"` adds a compliance of half a link at
+    /// the clamp, an error of first order in the base links' length, and that was the pinch's
+    /// first-order error. With `"half_link"` links ×2 moves the three drops without feedback by
+    /// 0.01-0.08 s (seeds 1-3), with `"whole_link"` by 0.27-0.41 s (the crimper's 10.14 s to
+    /// 9.82 s; models/README.md, "Where the pinch's first order came from").
     pub base_joint: BaseJoint,
     /// Strip length that can be grown out of the guide \[m\]; paper Sec. V grows 14.0 cm.
     pub length_m: f64,
@@ -499,10 +507,12 @@ pub struct FingerConfig {
     pub relaxed_fraction: f64,
     /// Relaxation time tau \[s\] of the standard linear solid (dashpot c = tau (1 - f) K).
     /// Tuned so that, as in the paper, the three objects drop ≈ 10, 13 and 17 s after the arm
-    /// starts: 18 s, with the objects' friction margins, turns the decay of the frozen grip into those
-    /// drop times on the converged finger (models/README.md has the figures: 15 s, the value on the
-    /// coarser 32-link finger, dropped all three 1.6-2.0 s early at 64 links; 21 s let the hammer
-    /// survive). Seconds to tens of seconds is the usual range of TPU stress relaxation.
+    /// starts: 19 s, with the objects' friction margins, turns the decay of the frozen grip into those
+    /// drop times on the converged finger (9.8-10.0 / 13.5 / 17.3 s, seeds 1-3). models/README.md
+    /// has the figures: 18 s, the value with the whole-link clamp, dropped the half-link finger
+    /// 0.3-1.0 s early; 20 s put the hammer's drop late in the lowering and 22 s let it survive;
+    /// 15 s, the value on the coarser 32-link finger, dropped all three 1.6-2.0 s early at 64
+    /// links. Seconds to tens of seconds is the usual range of TPU stress relaxation.
     pub relaxation_time_s: f64,
     /// Equivalent translating inertia of each MX-106 at its output \[kg\] (joint armature). A choice.
     pub motor_armature_kg: f64,
@@ -540,10 +550,10 @@ pub struct FingerConfig {
 impl Default for FingerConfig {
     fn default() -> Self {
         FingerConfig {
-            segments: 8,
+            segments: 7,
             base_refinement: 8,
             fine_from_m: 0.0,
-            base_joint: BaseJoint::WholeLink,
+            base_joint: BaseJoint::HalfLink,
             length_m: 0.14,
             thickness_m: 0.002,
             width_m: 0.02,
@@ -555,7 +565,7 @@ impl Default for FingerConfig {
             tendon_tension_decay_per_m: 25.0,
             tendon_stiffness_n_m: 6000.0,
             relaxed_fraction: 0.05,
-            relaxation_time_s: 18.0,
+            relaxation_time_s: 19.0,
             motor_armature_kg: 2.0,
             motor_kp_n_m: 20000.0,
             motor_kv_n_s_m: 400.0,

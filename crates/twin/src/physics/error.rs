@@ -89,7 +89,7 @@ pub enum Divergence {
         /// The warning's name.
         warning: &'static str,
     },
-    /// A contact is deeper than `physics.max_penetration_m`.
+    /// A contact is deeper than `physics.max_penetration_m` (a produce item's: or than its drop depth).
     #[error("contact {depth_m:.4} m deep between `{geom1}` and `{geom2}`")]
     Penetration {
         /// Penetration depth \[m\].

@@ -520,13 +520,16 @@ impl Scene {
             }
         }
         let bound = self.shared.spec.physics.max_penetration_m;
+        // A produce item's flex may go as deep as its soft contact lets a drop in.
+        let flex_bound = self.shared.produce.as_ref().map_or(bound, |p| bound.max(p.calibration.drop_depth_m()));
         if let (Some(run), Some(ids)) = (&self.produce, &self.shared.ids.produce)
             && let Some(cause) = run.inverted(ids, &self.data)
         {
             return diverged(cause);
         }
         for c in self.data.contact() {
-            if c.dist < -bound {
+            let allowed = if c.flex.iter().any(|&f| f >= 0) { flex_bound } else { bound };
+            if c.dist < -allowed {
                 // A flex's side of a contact has no geom (-1): it is named by its flex.
                 let name = |k: usize| match (c.geom[k], c.flex[k]) {
                     (g, _) if g >= 0 => {

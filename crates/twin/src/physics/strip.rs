@@ -185,8 +185,8 @@ mod tests {
             );
             assert!(zoned.len() < layout(&graded).len(), "{fine_from}");
         }
-        // One coarse link in place of the first eight fine ones at 17.5 mm: 23 bodies against 30.
-        assert_eq!(layout(&FingerConfig { fine_from_m: l, ..graded }).len(), 23);
+        // One coarse link in place of the first eight fine ones at 20 mm: 21 bodies against 28.
+        assert_eq!(layout(&FingerConfig { fine_from_m: l, ..graded }).len(), 21);
     }
 
     #[test]
@@ -196,19 +196,20 @@ mod tests {
         let pad_start = f.pad_position_m - PAD_HALF_LENGTH_M;
         let (base, beyond): (Vec<&Piece>, Vec<&Piece>) =
             pieces.iter().filter(|p| !p.fixed).partition(|p| p.start_m < pad_start);
-        // 2.2 mm up to the pad (the uniform 64-link finger's links, where its answers converged),
-        // 17.5 mm beyond it: 30 bodies in all, against the uniform finger's 55.
-        assert!(base.iter().all(|p| (p.length_m - 0.14 / 64.0).abs() < 0.6e-3), "{base:?}");
-        assert!(beyond.iter().all(|p| p.length_m > 0.015), "{beyond:?}");
-        assert_eq!(pieces.len(), 30);
+        // 2.5 mm up to the pad (a 56-link strip's links; the answers converge there with the
+        // clamp's joint at half a link, models/README.md), 20 mm beyond it but for the pieces the
+        // pad and the tip cut short: 28 bodies in all, against the uniform 64-link finger's 55.
+        assert!(base.iter().all(|p| (p.length_m - 0.14 / 56.0).abs() < 0.6e-3), "{base:?}");
+        assert!(beyond.iter().all(|p| p.length_m > 0.009 && p.length_m < 0.0201), "{beyond:?}");
+        assert_eq!(pieces.len(), 28);
         let uniform = layout(&FingerConfig { segments: 64, base_refinement: 1, ..f });
         assert_eq!(uniform.len(), 55);
     }
 
     #[test]
     fn the_clamp_s_joint_stands_for_the_first_link_or_its_half_and_no_other_joint_moves() {
-        for f in [FingerConfig::default(), FingerConfig { segments: 32, base_refinement: 1, ..FingerConfig::default() }]
-        {
+        let whole_link = FingerConfig { base_joint: BaseJoint::WholeLink, ..FingerConfig::default() };
+        for f in [whole_link.clone(), FingerConfig { segments: 32, base_refinement: 1, ..whole_link }] {
             let whole = layout(&f);
             let half = layout(&FingerConfig { base_joint: BaseJoint::HalfLink, ..f.clone() });
             let first = whole[0].length_m;
