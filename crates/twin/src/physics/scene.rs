@@ -35,6 +35,10 @@ pub struct SceneModel {
     guide_pruning: Option<Arc<GuidePruning>>,
     /// The produce item, when the object is one: as configured, and its flex's calibration.
     produce: Option<Arc<ProducePart>>,
+    /// The deepest a contact with the produce item's flex may go \[m\]: `physics.max_penetration_m`,
+    /// or deeper where the item's soft contact lets a drop in further
+    /// ([`super::plates::Calibration::drop_depth_m`]); set once here, read every step.
+    flex_penetration_bound_m: f64,
 }
 
 /// Ids of the elements the readout and the backends need (MuJoCo's numbering, which the rapier
@@ -137,6 +141,8 @@ impl SceneModel {
             }
         }
         let guide_pruning = GuidePruning::new(&model).map(Arc::new);
+        let bound = spec.physics.max_penetration_m;
+        let flex_penetration_bound_m = produce.as_ref().map_or(bound, |p| bound.max(p.calibration.drop_depth_m()));
         let shared = Arc::new(SceneModel {
             model: Arc::new(model),
             spec: spec.clone(),
@@ -145,6 +151,7 @@ impl SceneModel {
             ids,
             guide_pruning,
             produce: produce.map(Arc::new),
+            flex_penetration_bound_m,
         });
         if spec.physics.backend == Backend::Rapier {
             // Translate once now, so an element rapier cannot take is an error before any run starts.
@@ -520,15 +527,13 @@ impl Scene {
             }
         }
         let bound = self.shared.spec.physics.max_penetration_m;
-        // A produce item's flex may go as deep as its soft contact lets a drop in.
-        let flex_bound = self.shared.produce.as_ref().map_or(bound, |p| bound.max(p.calibration.drop_depth_m()));
         if let (Some(run), Some(ids)) = (&self.produce, &self.shared.ids.produce)
             && let Some(cause) = run.inverted(ids, &self.data)
         {
             return diverged(cause);
         }
         for c in self.data.contact() {
-            let allowed = if c.flex.iter().any(|&f| f >= 0) { flex_bound } else { bound };
+            let allowed = if c.flex.iter().any(|&f| f >= 0) { self.shared.flex_penetration_bound_m } else { bound };
             if c.dist < -allowed {
                 // A flex's side of a contact has no geom (-1): it is named by its flex.
                 let name = |k: usize| match (c.geom[k], c.flex[k]) {
